@@ -1,0 +1,60 @@
+//! # gaitclip — stride lengths from a shoe-clip IMU, in fixed point
+//!
+//! gaitclip turns the raw samples of an MPU6050 clipped to a shoe into one record per
+//! stride: when it started, when the heel left the ground, when the toe left it, when the
+//! heel struck, when the foot was flat again, and how long the stride was.
+//!
+//! ## Design
+//!
+//! **The unit of output is the stride, the unit of work is the sample.** Each sample goes
+//! through a fixed chain of stages, in this order, each fed only the records of the stage
+//! before it:
+//!
+//! 1. [`mpu6050`] — the driver: one burst read per sample into a [`sample::RawSample`] of
+//!    counts. Nothing later looks at a register.
+//! 2. [`mean_filter`] — a moving average over a power-of-two ring with a running sum.
+//! 3. [`stance`] — is the foot at rest? Variance of specific force and angular-rate energy
+//!    over a window, both orientation-free, against thresholds set in physical units.
+//! 4. [`stride`] — stance-to-stance segmentation, the gait events inside a stride, and
+//!    [`zupt`] strapdown integration with zero-velocity updates for its length.
+//!
+//! [`pipeline::Pipeline`] composes them; a board or a host tool only feeds samples and
+//! reads strides.
+//!
+//! **Integer on the sample path.** The per-sample work is integer arithmetic with documented
+//! scaling ([`fixed`]): Q30 quaternions, counts·2⁸ accelerations, `i64` integrals. The same
+//! code therefore gives bit-identical strides on a Cortex-M0 without an FPU, on a Cortex-M4,
+//! and on the host that replays recordings; tests compare the two.
+//!
+//! **No heap, no panics, bounded state.** Every buffer is a compile-time capacity
+//! ([`stance::WINDOW_CAPACITY`], [`pipeline::DELAY_CAPACITY`],
+//! [`stride::MAX_MOVEMENT_SAMPLES`]); a movement longer than its buffer is flagged, never
+//! grown. Arithmetic that could overflow on hostile input saturates or is bounded by the
+//! capacities.
+//!
+//! **What the core refuses to know.** Boards, log transports and file formats live outside:
+//! `boards/` feeds samples from a sensor or a replayed trace and logs over defmt;
+//! `tests-host/` reads CSV and MCAP. The core forbids `unsafe`.
+//!
+//! **Orientation-free.** A clip is mounted however the user mounts it. Stance detection uses
+//! only magnitudes; the ZUPT integrator levels itself from gravity at every stance and
+//! measures horizontal distance, which does not depend on yaw.
+//!
+//! ## Units
+//!
+//! Sample indices count from the first sample fed (gaps included). Lengths are in mm.
+//! The sample rate ([`rate::SampleRate`]) is in millihertz so that 204.8 Hz is exact.
+
+#![no_std]
+#![forbid(unsafe_code)]
+#![deny(missing_docs)]
+
+pub mod fixed;
+pub mod mean_filter;
+pub mod mpu6050;
+pub mod pipeline;
+pub mod rate;
+pub mod sample;
+pub mod stance;
+pub mod stride;
+pub mod zupt;

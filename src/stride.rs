@@ -1,0 +1,252 @@
+//! Strides from stance to stance, their gait events, and their length.
+//!
+//! A stride runs from one foot-flat (start of a stance) to the next. Inside it:
+//!
+//! ```text
+//!  start (foot-flat)   heel_off       toe_off          heel_strike   end (next foot-flat)
+//!  |---- stance -------|-- push-off --|----- swing -----|-- heel-strike --|
+//! ```
+//!
+//! First version of the phase boundaries (orientation-free): toe-off is the largest specific
+//! force in the first half of the movement (the push-off burst), heel-strike the largest in
+//! the second half (the impact). The length is the ZUPT displacement of the movement.
+//!
+//! Streaming and bounded: the only per-stride memory is the magnitude of each movement
+//! sample, [`MAX_MOVEMENT_SAMPLES`] of them; a longer movement is still closed at the next
+//! stance but flagged [`StrideFlags::TOO_LONG`].
+
+use heapless::Vec;
+
+use crate::rate::SampleRate;
+use crate::sample::{GyroRange, RawSample};
+use crate::zupt::ZuptIntegrator;
+
+/// Capacity of the movement buffer: 2.048 s at 1 kHz, 20 s at 100 Hz.
+pub const MAX_MOVEMENT_SAMPLES: usize = 2048;
+/// A movement shorter than this is a wobble of a foot still on the ground, not a step.
+pub const MIN_MOVEMENT_MS: u32 = 150;
+/// At most this much of a stance counts toward the stride that leaves it: a user who stood
+/// for a minute before walking has a first stride of one step, not of a minute.
+pub const MAX_STANCE_IN_STRIDE_MS: u32 = 1000;
+
+/// Properties of a stride that qualify its length.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
+pub struct StrideFlags(pub u8);
+
+impl StrideFlags {
+    /// A sample of the movement sat at a rail of its range: the length is uncertain.
+    pub const SATURATED: u8 = 1 << 0;
+    /// The movement overflowed [`MAX_MOVEMENT_SAMPLES`]: not a walking stride.
+    pub const TOO_LONG: u8 = 1 << 1;
+    /// The stride starts from a stance longer than [`MAX_STANCE_IN_STRIDE_MS`]: the first
+    /// step after standing (informational).
+    pub const FROM_REST: u8 = 1 << 2;
+    /// Flags that make a length untrustworthy.
+    pub const INVALID: u8 = Self::SATURATED | Self::TOO_LONG;
+
+    /// True when no flag in [`StrideFlags::INVALID`] is set.
+    pub const fn valid(self) -> bool {
+        self.0 & Self::INVALID == 0
+    }
+
+    /// True when `flag` is set.
+    pub const fn has(self, flag: u8) -> bool {
+        self.0 & flag != 0
+    }
+}
+
+/// One stride. Indices are sample numbers since the pipeline started.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
+pub struct Stride {
+    /// Running stride number, from 0.
+    pub index: u32,
+    /// First sample (a foot-flat, or at most [`MAX_STANCE_IN_STRIDE_MS`] before heel-off).
+    pub start: u32,
+    /// End of stance: first sample of the movement.
+    pub heel_off: u32,
+    /// Toe-off: push-off ends, swing begins.
+    pub toe_off: u32,
+    /// Heel-strike: swing ends.
+    pub heel_strike: u32,
+    /// Foot-flat ending the stride (the next stride's start); exclusive end.
+    pub end: u32,
+    /// Horizontal length of the stride, mm.
+    pub length_mm: u32,
+    /// Height gained over the stride, mm (stairs, slopes).
+    pub climb_mm: i32,
+    /// Qualifiers.
+    pub flags: StrideFlags,
+}
+
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum State {
+    /// No stance seen yet: nothing to integrate from.
+    Unprimed,
+    Stance,
+    Moving,
+}
+
+/// Turns stance decisions into strides.
+#[derive(Clone, Debug)]
+pub struct StrideTracker {
+    state: State,
+    min_movement: u32,
+    max_stance: u32,
+    zupt: ZuptIntegrator,
+    stance_start: u32,
+    heel_off: u32,
+    accel_sum: [i64; 3],
+    gyro_sum: [i64; 3],
+    stance_samples: u32,
+    magnitude: Vec<u32, MAX_MOVEMENT_SAMPLES>,
+    flags: u8,
+    next_index: u32,
+}
+
+/// Stance accumulators are halved at this count so that standing for hours cannot overflow
+/// them (sums stay below 2³² for i16 inputs).
+const STANCE_SUM_HALVING_AT: u32 = 1 << 16;
+
+impl StrideTracker {
+    /// A tracker for a sample rate and gyro range.
+    pub const fn new(rate: SampleRate, gyro: GyroRange) -> Self {
+        StrideTracker {
+            state: State::Unprimed,
+            min_movement: rate.samples_in_ms(MIN_MOVEMENT_MS),
+            max_stance: rate.samples_in_ms(MAX_STANCE_IN_STRIDE_MS),
+            zupt: ZuptIntegrator::new(rate, gyro),
+            stance_start: 0,
+            heel_off: 0,
+            accel_sum: [0; 3],
+            gyro_sum: [0; 3],
+            stance_samples: 0,
+            magnitude: Vec::new(),
+            flags: 0,
+            next_index: 0,
+        }
+    }
+
+    /// Drops any stride in progress and waits for the next stance (after a gap).
+    pub fn reset(&mut self) {
+        self.state = State::Unprimed;
+        self.clear_stance();
+    }
+
+    fn clear_stance(&mut self) {
+        self.accel_sum = [0; 3];
+        self.gyro_sum = [0; 3];
+        self.stance_samples = 0;
+    }
+
+    /// Feeds sample number `index`, its raw values and whether the foot is at rest there.
+    pub fn process(&mut self, index: u32, s: &RawSample, stance: bool) -> Option<Stride> {
+        match (self.state, stance) {
+            (State::Unprimed, false) => None,
+            (State::Unprimed, true) => {
+                self.state = State::Stance;
+                self.stance_start = index;
+                self.clear_stance();
+                self.accumulate_stance(s);
+                None
+            }
+            (State::Stance, true) => {
+                self.accumulate_stance(s);
+                None
+            }
+            (State::Stance, false) => {
+                if self
+                    .zupt
+                    .start(self.accel_sum, self.gyro_sum, self.stance_samples)
+                {
+                    self.state = State::Moving;
+                    self.heel_off = index;
+                    self.magnitude.clear();
+                    self.flags = 0;
+                    self.accumulate_movement(s);
+                }
+                None
+            }
+            (State::Moving, false) => {
+                self.accumulate_movement(s);
+                None
+            }
+            (State::Moving, true) => {
+                let moved = index.wrapping_sub(self.heel_off);
+                self.state = State::Stance;
+                if moved < self.min_movement {
+                    // A wobble: the stance goes on, with its start and sums as they were.
+                    self.accumulate_stance(s);
+                    return None;
+                }
+                let stride = self.close(index);
+                self.stance_start = index;
+                self.clear_stance();
+                self.accumulate_stance(s);
+                Some(stride)
+            }
+        }
+    }
+
+    fn accumulate_stance(&mut self, s: &RawSample) {
+        if self.stance_samples >= STANCE_SUM_HALVING_AT {
+            self.accel_sum = self.accel_sum.map(|v| v / 2);
+            self.gyro_sum = self.gyro_sum.map(|v| v / 2);
+            self.stance_samples /= 2;
+        }
+        for i in 0..3 {
+            self.accel_sum[i] += s.accel[i] as i64;
+            self.gyro_sum[i] += s.gyro[i] as i64;
+        }
+        self.stance_samples += 1;
+    }
+
+    fn accumulate_movement(&mut self, s: &RawSample) {
+        self.zupt.process(s);
+        let m: u32 = s
+            .accel
+            .iter()
+            .map(|&v| (v as i32 * v as i32) as u32)
+            .fold(0u32, u32::saturating_add);
+        if self.magnitude.push(m).is_err() {
+            self.flags |= StrideFlags::TOO_LONG;
+        }
+        if s.is_saturated() {
+            self.flags |= StrideFlags::SATURATED;
+        }
+    }
+
+    fn close(&mut self, foot_flat: u32) -> Stride {
+        let half = self.magnitude.len() / 2;
+        let argmax = |xs: &[u32]| {
+            xs.iter()
+                .enumerate()
+                .fold((0usize, 0u32), |best, (i, &v)| if v > best.1 { (i, v) } else { best })
+                .0 as u32
+        };
+        let toe_off = self.heel_off + argmax(&self.magnitude[..half]);
+        let heel_strike = self.heel_off + half as u32 + argmax(&self.magnitude[half..]);
+        let stance = self.heel_off - self.stance_start;
+        let mut flags = self.flags;
+        let start = if stance > self.max_stance {
+            flags |= StrideFlags::FROM_REST;
+            self.heel_off - self.max_stance
+        } else {
+            self.stance_start
+        };
+        let d = self.zupt.displacement();
+        let index = self.next_index;
+        self.next_index = self.next_index.wrapping_add(1);
+        Stride {
+            index,
+            start,
+            heel_off: self.heel_off,
+            toe_off,
+            heel_strike,
+            end: foot_flat,
+            length_mm: ((d.horizontal_um + 500) / 1000).min(u32::MAX as u64) as u32,
+            climb_mm: ((d.vertical_um + 500).div_euclid(1000)).clamp(i32::MIN as i64, i32::MAX as i64)
+                as i32,
+            flags: StrideFlags(flags),
+        }
+    }
+}

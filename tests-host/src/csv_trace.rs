@@ -1,0 +1,192 @@
+//! Reading and writing traces as CSV in the layout of `../shared/datasets`:
+//! header `t_s,acc_x,acc_y,acc_z,gyr_x,gyr_y,gyr_z`, m/s² and rad/s.
+
+use std::fs;
+use std::io::Write;
+use std::path::{Path, PathBuf};
+
+use crate::trace::{ImuSample, Trace};
+
+/// The columns, in the order the datasets write them.
+pub const COLUMNS: [&str; 7] = ["t_s", "acc_x", "acc_y", "acc_z", "gyr_x", "gyr_y", "gyr_z"];
+
+/// What went wrong reading a CSV trace. Every variant names the file; cell errors also the
+/// 1-based line and column.
+#[derive(Debug, thiserror::Error)]
+pub enum CsvError {
+    /// The file could not be opened or read.
+    #[error("{path}: {source}")]
+    Io {
+        /// The file.
+        path: PathBuf,
+        /// The cause.
+        source: std::io::Error,
+    },
+    /// A required column is missing from the header.
+    #[error("{path}: line 1: missing column `{column}` (header has: {header})")]
+    MissingColumn {
+        /// The file.
+        path: PathBuf,
+        /// The column.
+        column: &'static str,
+        /// The header as read.
+        header: String,
+    },
+    /// A cell is not a finite number.
+    #[error("{path}:{line}:{col}: column `{column}`: `{text}` is not a finite number")]
+    BadNumber {
+        /// The file.
+        path: PathBuf,
+        /// 1-based line number.
+        line: u64,
+        /// 1-based column number.
+        col: usize,
+        /// Column name.
+        column: &'static str,
+        /// The cell text.
+        text: String,
+    },
+    /// A row is structurally broken (wrong field count, bad UTF-8 …).
+    #[error("{path}:{line}: {message}")]
+    Malformed {
+        /// The file.
+        path: PathBuf,
+        /// 1-based line number.
+        line: u64,
+        /// The parser's message.
+        message: String,
+    },
+    /// The file has a header but no samples.
+    #[error("{path}: no samples")]
+    Empty {
+        /// The file.
+        path: PathBuf,
+    },
+    /// `meta.json` beside the file exists but is not usable.
+    #[error("{path}: {message}")]
+    Meta {
+        /// The meta.json file.
+        path: PathBuf,
+        /// What is wrong.
+        message: String,
+    },
+}
+
+/// Reads a CSV trace. The rate comes from `rate_hz` if given, else from a `meta.json` beside
+/// the file (`sample_rate_hz`), else from the median interval of `t_s`.
+pub fn read(path: &Path, rate_hz: Option<f64>) -> Result<Trace, CsvError> {
+    let text = fs::read(path).map_err(|source| CsvError::Io {
+        path: path.to_owned(),
+        source,
+    })?;
+    let samples = parse(path, &text)?;
+    let rate_hz = match rate_hz {
+        Some(r) => r,
+        None => match meta_rate(path)? {
+            Some(r) => r,
+            None => Trace::rate_from_timestamps(&samples).ok_or_else(|| CsvError::Empty {
+                path: path.to_owned(),
+            })?,
+        },
+    };
+    Ok(Trace { samples, rate_hz })
+}
+
+fn meta_rate(csv: &Path) -> Result<Option<f64>, CsvError> {
+    let meta = csv.with_file_name("meta.json");
+    let Ok(text) = fs::read_to_string(&meta) else {
+        return Ok(None);
+    };
+    let v: serde_json::Value = serde_json::from_str(&text).map_err(|e| CsvError::Meta {
+        path: meta.clone(),
+        message: e.to_string(),
+    })?;
+    match v.get("sample_rate_hz") {
+        None => Ok(None),
+        Some(r) => r.as_f64().filter(|r| *r > 0.0).map(Some).ok_or(CsvError::Meta {
+            path: meta,
+            message: format!("sample_rate_hz is not a positive number: {r}"),
+        }),
+    }
+}
+
+/// Parses CSV bytes; `path` is only used in error messages.
+pub fn parse(path: &Path, bytes: &[u8]) -> Result<Vec<ImuSample>, CsvError> {
+    let mut rdr = csv::ReaderBuilder::new()
+        .has_headers(true)
+        .trim(csv::Trim::All)
+        .from_reader(bytes);
+    let malformed = |e: csv::Error| CsvError::Malformed {
+        path: path.to_owned(),
+        line: e.position().map_or(0, |p| p.line()),
+        message: e.to_string(),
+    };
+    let header = rdr.headers().map_err(malformed)?.clone();
+    let mut idx = [0usize; 7];
+    for (slot, name) in idx.iter_mut().zip(COLUMNS) {
+        *slot = header
+            .iter()
+            .position(|h| h == name)
+            .ok_or_else(|| CsvError::MissingColumn {
+                path: path.to_owned(),
+                column: name,
+                header: header.iter().collect::<Vec<_>>().join(","),
+            })?;
+    }
+    let mut out = Vec::new();
+    let mut rec = csv::StringRecord::new();
+    loop {
+        match rdr.read_record(&mut rec) {
+            Ok(false) => break,
+            Ok(true) => {}
+            Err(e) => return Err(malformed(e)),
+        }
+        let line = rec.position().map_or(0, |p| p.line());
+        let mut v = [0f64; 7];
+        for (k, (&i, name)) in idx.iter().zip(COLUMNS).enumerate() {
+            let text = rec.get(i).unwrap_or("");
+            v[k] = text
+                .parse::<f64>()
+                .ok()
+                .filter(|x| x.is_finite())
+                .ok_or_else(|| CsvError::BadNumber {
+                    path: path.to_owned(),
+                    line,
+                    col: i + 1,
+                    column: name,
+                    text: text.to_owned(),
+                })?;
+        }
+        out.push(ImuSample {
+            t_s: v[0],
+            acc_mps2: [v[1], v[2], v[3]],
+            gyr_radps: [v[4], v[5], v[6]],
+        });
+    }
+    if out.is_empty() {
+        return Err(CsvError::Empty {
+            path: path.to_owned(),
+        });
+    }
+    Ok(out)
+}
+
+/// Writes a trace as CSV. Values are printed in Rust's shortest round-trip form, so reading
+/// the file back gives the same `f64`s and the same counts.
+pub fn write(mut w: impl Write, samples: &[ImuSample]) -> std::io::Result<()> {
+    writeln!(w, "{}", COLUMNS.join(","))?;
+    for s in samples {
+        writeln!(
+            w,
+            "{:.6},{},{},{},{},{},{}",
+            s.t_s,
+            s.acc_mps2[0],
+            s.acc_mps2[1],
+            s.acc_mps2[2],
+            s.gyr_radps[0],
+            s.gyr_radps[1],
+            s.gyr_radps[2]
+        )?;
+    }
+    Ok(())
+}

@@ -1,0 +1,7 @@
+//! Host tools for gaitclip: read CSV and MCAP traces, replay them through the same
+//! `no_std` core the firmware runs, simulate gait fixtures with ground truth, and run the
+//! firmware in QEMU with its defmt log decoded.
+
+pub mod csv_trace;
+pub mod replay;
+pub mod trace;

@@ -1,0 +1,111 @@
+//! Runs a trace through the firmware core, exactly as the board does, and reports strides
+//! in the trace's own clock.
+
+use gaitclip::pipeline::{Config, Pipeline};
+use gaitclip::rate::SampleRate;
+use gaitclip::sample::RawSample;
+use gaitclip::stride::{Stride, StrideFlags};
+use serde::Serialize;
+
+use crate::trace::{Ranges, Trace};
+
+/// Why a trace cannot be replayed.
+#[derive(Debug, thiserror::Error)]
+pub enum ReplayError {
+    /// The rate is outside what the core supports.
+    #[error("sample rate {0} Hz is outside 100–1000 Hz")]
+    Rate(f64),
+}
+
+/// A stride as the host reports it.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct StrideReport {
+    /// Stride number from 0.
+    pub index: u32,
+    /// Start (foot-flat), s in the trace's clock.
+    pub start_s: f64,
+    /// End (next foot-flat), s.
+    pub end_s: f64,
+    /// Length from the default model, m.
+    pub length_m: f64,
+    /// Heel-off (end of stance), s.
+    pub heel_off_s: f64,
+    /// Toe-off, s.
+    pub toe_off_s: f64,
+    /// Heel-strike, s.
+    pub heel_strike_s: f64,
+    /// Foot-flat ending the stride, s (same as `end_s`).
+    pub foot_flat_s: f64,
+    /// Height gained, m.
+    pub climb_m: f64,
+    /// False when the length is not to be trusted (see `flags`).
+    pub valid: bool,
+    /// Names of the flags set.
+    pub flags: Vec<&'static str>,
+    /// The core's integer record, as the firmware logs it.
+    #[serde(skip)]
+    pub raw: Stride,
+}
+
+/// Names of the stride flags, in bit order.
+pub fn flag_names(f: StrideFlags) -> Vec<&'static str> {
+    let mut v = Vec::new();
+    if f.has(StrideFlags::SATURATED) {
+        v.push("saturated");
+    }
+    if f.has(StrideFlags::TOO_LONG) {
+        v.push("too_long");
+    }
+    if f.has(StrideFlags::FROM_REST) {
+        v.push("from_rest");
+    }
+    v
+}
+
+/// Replays raw counts at `rate` through the core. `t_s(i)` gives the time of sample `i`.
+pub fn replay_counts(
+    samples: &[RawSample],
+    rate: SampleRate,
+    ranges: Ranges,
+    t_s: impl Fn(u32) -> f64,
+) -> Vec<StrideReport> {
+    let mut p = Pipeline::new(Config {
+        rate,
+        accel: ranges.accel,
+        gyro: ranges.gyro,
+    });
+    let mut strides: Vec<Stride> = samples.iter().filter_map(|s| p.process(s)).collect();
+    strides.extend(p.finish());
+    strides.into_iter().map(|s| report(s, &t_s)).collect()
+}
+
+/// Replays a trace in physical units: converts to counts at `ranges` (with saturation) first.
+pub fn replay(trace: &Trace, ranges: Ranges) -> Result<Vec<StrideReport>, ReplayError> {
+    let rate = trace.sample_rate().ok_or(ReplayError::Rate(trace.rate_hz))?;
+    let counts: Vec<RawSample> = trace.samples.iter().map(|s| ranges.to_counts(s)).collect();
+    let times: Vec<f64> = trace.samples.iter().map(|s| s.t_s).collect();
+    let dt = 1.0 / trace.rate_hz;
+    let t_s = |i: u32| match times.get(i as usize) {
+        Some(&t) => t,
+        // Past the end (cannot happen for events, which lie on fed samples): extrapolate.
+        None => times.last().copied().unwrap_or(0.0) + dt * (i as f64 - times.len() as f64 + 1.0),
+    };
+    Ok(replay_counts(&counts, rate, ranges, t_s))
+}
+
+fn report(s: Stride, t_s: &impl Fn(u32) -> f64) -> StrideReport {
+    StrideReport {
+        index: s.index,
+        start_s: t_s(s.start),
+        end_s: t_s(s.end),
+        length_m: s.length_mm as f64 / 1000.0,
+        heel_off_s: t_s(s.heel_off),
+        toe_off_s: t_s(s.toe_off),
+        heel_strike_s: t_s(s.heel_strike),
+        foot_flat_s: t_s(s.end),
+        climb_m: s.climb_mm as f64 / 1000.0,
+        valid: s.flags.valid(),
+        flags: flag_names(s.flags),
+        raw: s,
+    }
+}

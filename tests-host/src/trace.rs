@@ -1,0 +1,101 @@
+//! A recorded trace in physical units and its conversion to MPU6050 counts.
+
+use gaitclip::rate::SampleRate;
+use gaitclip::sample::{AccelRange, GyroRange, RawSample};
+
+/// Standard gravity, m/s² per g.
+pub const G_MPS2: f64 = 9.80665;
+
+/// One sample in physical units, sensor axes.
+#[derive(Clone, Copy, Debug, PartialEq, Default)]
+pub struct ImuSample {
+    /// Time in the trace's own clock, s.
+    pub t_s: f64,
+    /// Specific force (gravity included), m/s².
+    pub acc_mps2: [f64; 3],
+    /// Angular rate, rad/s.
+    pub gyr_radps: [f64; 3],
+}
+
+/// A recording: samples in physical units and the nominal rate.
+#[derive(Clone, Debug, PartialEq, Default)]
+pub struct Trace {
+    /// The samples, in time order.
+    pub samples: Vec<ImuSample>,
+    /// Nominal sample rate, Hz.
+    pub rate_hz: f64,
+}
+
+/// Sensor ranges used to turn physical units into counts.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
+pub struct Ranges {
+    /// Accelerometer range.
+    pub accel: AccelRange,
+    /// Gyroscope range.
+    pub gyro: GyroRange,
+}
+
+impl Ranges {
+    /// Counts per m/s².
+    pub fn accel_counts_per_mps2(self) -> f64 {
+        self.accel.lsb_per_g() as f64 / G_MPS2
+    }
+
+    /// Counts per rad/s.
+    pub fn gyro_counts_per_radps(self) -> f64 {
+        self.gyro.lsb_per_dps_x10() as f64 / 10.0 * 180.0 / std::f64::consts::PI
+    }
+
+    /// Converts to counts as the sensor would report them: rounded to the nearest count and
+    /// saturated at the rails (a heel strike beyond ±16 g reads as the rail).
+    pub fn to_counts(self, s: &ImuSample) -> RawSample {
+        let a = self.accel_counts_per_mps2();
+        let g = self.gyro_counts_per_radps();
+        RawSample {
+            accel: s.acc_mps2.map(|v| quantize(v * a)),
+            gyro: s.gyr_radps.map(|v| quantize(v * g)),
+            temp: 0,
+        }
+    }
+
+    /// The physical value of counts (inverse of [`Ranges::to_counts`] up to quantisation).
+    pub fn to_physical(self, t_s: f64, r: &RawSample) -> ImuSample {
+        let a = self.accel_counts_per_mps2();
+        let g = self.gyro_counts_per_radps();
+        ImuSample {
+            t_s,
+            acc_mps2: r.accel.map(|c| c as f64 / a),
+            gyr_radps: r.gyro.map(|c| c as f64 / g),
+        }
+    }
+}
+
+/// Rounds to the nearest count and saturates to the i16 range; NaN reads as 0.
+pub fn quantize(v: f64) -> i16 {
+    if v.is_nan() {
+        0
+    } else {
+        v.round().clamp(i16::MIN as f64, i16::MAX as f64) as i16
+    }
+}
+
+impl Trace {
+    /// The nominal rate as the core's [`SampleRate`], if within 100–1000 Hz.
+    pub fn sample_rate(&self) -> Option<SampleRate> {
+        SampleRate::from_millihertz((self.rate_hz * 1000.0).round() as u32)
+    }
+
+    /// Estimates the rate from the median sample interval.
+    pub fn rate_from_timestamps(samples: &[ImuSample]) -> Option<f64> {
+        let mut dts: Vec<f64> = samples
+            .windows(2)
+            .map(|w| w[1].t_s - w[0].t_s)
+            .filter(|d| d.is_finite() && *d > 0.0)
+            .collect();
+        if dts.is_empty() {
+            return None;
+        }
+        dts.sort_by(f64::total_cmp);
+        Some(1.0 / dts[dts.len() / 2])
+    }
+}
