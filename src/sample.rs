@@ -22,6 +22,17 @@ impl AccelRange {
         16384 >> self.afs_sel()
     }
 
+    /// The range for an `AFS_SEL` field value; `None` above 3.
+    pub const fn from_afs_sel(v: u8) -> Option<Self> {
+        match v {
+            0 => Some(AccelRange::G2),
+            1 => Some(AccelRange::G4),
+            2 => Some(AccelRange::G8),
+            3 => Some(AccelRange::G16),
+            _ => None,
+        }
+    }
+
     /// The `AFS_SEL` field value (0..=3).
     pub const fn afs_sel(self) -> u8 {
         match self {
@@ -55,6 +66,17 @@ impl GyroRange {
             GyroRange::Dps500 => 655,
             GyroRange::Dps1000 => 328,
             GyroRange::Dps2000 => 164,
+        }
+    }
+
+    /// The range for an `FS_SEL` field value; `None` above 3.
+    pub const fn from_fs_sel(v: u8) -> Option<Self> {
+        match v {
+            0 => Some(GyroRange::Dps250),
+            1 => Some(GyroRange::Dps500),
+            2 => Some(GyroRange::Dps1000),
+            3 => Some(GyroRange::Dps2000),
+            _ => None,
         }
     }
 

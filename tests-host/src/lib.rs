@@ -5,3 +5,4 @@
 pub mod csv_trace;
 pub mod replay;
 pub mod trace;
+pub mod qemu;
