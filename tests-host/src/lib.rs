@@ -6,3 +6,5 @@ pub mod csv_trace;
 pub mod replay;
 pub mod trace;
 pub mod qemu;
+pub mod sim;
+pub mod fixtures;

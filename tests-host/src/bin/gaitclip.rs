@@ -3,7 +3,7 @@ use std::path::PathBuf;
 use std::process::ExitCode;
 
 use clap::{Parser, Subcommand};
-use gaitclip_host::{csv_trace, replay, trace::Ranges};
+use gaitclip_host::{csv_trace, fixtures, replay, trace::Ranges};
 
 #[derive(Parser)]
 #[command(name = "gaitclip", version, about = "Replay IMU traces through the gaitclip firmware core")]
@@ -24,6 +24,12 @@ enum Cmd {
         /// One JSON object per stride per line.
         #[arg(long)]
         json: bool,
+    },
+    /// Regenerate the simulated fixtures (traces with ground truth) into a folder.
+    Simulate {
+        /// Output folder.
+        #[arg(long, default_value = "../fixtures")]
+        out: PathBuf,
     },
 }
 
@@ -55,6 +61,10 @@ fn run(cli: Cli) -> anyhow::Result<()> {
             }
             let total: f64 = strides.iter().map(|s| s.length_m).sum();
             eprintln!("{} strides, {:.2} m", strides.len(), total);
+        }
+        Cmd::Simulate { out } => {
+            fixtures::write_all(&out)?;
+            eprintln!("wrote fixtures to {}", out.display());
         }
     }
     Ok(())
