@@ -8,3 +8,4 @@ pub mod trace;
 pub mod qemu;
 pub mod sim;
 pub mod fixtures;
+pub mod mcap_io;

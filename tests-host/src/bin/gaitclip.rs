@@ -1,9 +1,11 @@
 //! `gaitclip`: the host command line.
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 
+use anyhow::Context;
 use clap::{Parser, Subcommand};
-use gaitclip_host::{csv_trace, fixtures, replay, trace::Ranges};
+use gaitclip_host::trace::{Ranges, Trace};
+use gaitclip_host::{csv_trace, fixtures, mcap_io, replay};
 
 #[derive(Parser)]
 #[command(name = "gaitclip", version, about = "Replay IMU traces through the gaitclip firmware core")]
@@ -14,16 +16,19 @@ struct Cli {
 
 #[derive(Subcommand)]
 enum Cmd {
-    /// Replay a CSV or MCAP trace and print one line per stride.
+    /// Replay a CSV or MCAP trace through the firmware core and print one line per stride.
     Replay {
-        /// The trace (.csv, .mcap).
+        /// The trace: `.csv` (t_s,acc_x,acc_y,acc_z,gyr_x,gyr_y,gyr_z in m/s², rad/s) or `.mcap`.
         trace: PathBuf,
-        /// Sample rate in Hz (default: meta.json beside the file, else the timestamps).
+        /// Sample rate in Hz (default: meta.json beside a CSV, else the timestamps).
         #[arg(long)]
         rate: Option<f64>,
         /// One JSON object per stride per line.
         #[arg(long)]
         json: bool,
+        /// Also write the samples and the strides to this MCAP file (opens in Foxglove).
+        #[arg(long, value_name = "FILE")]
+        mcap_out: Option<PathBuf>,
     },
     /// Regenerate the simulated fixtures (traces with ground truth) into a folder.
     Simulate {
@@ -44,23 +49,53 @@ fn main() -> ExitCode {
     }
 }
 
+fn read_trace(path: &Path, rate: Option<f64>) -> anyhow::Result<Trace> {
+    let is_mcap = path
+        .extension()
+        .is_some_and(|e| e.eq_ignore_ascii_case("mcap"));
+    Ok(if is_mcap {
+        mcap_io::read(path, rate)?
+    } else {
+        csv_trace::read(path, rate)?
+    })
+}
+
 fn run(cli: Cli) -> anyhow::Result<()> {
     match cli.cmd {
-        Cmd::Replay { trace, rate, json } => {
-            let t = csv_trace::read(&trace, rate)?;
+        Cmd::Replay {
+            trace,
+            rate,
+            json,
+            mcap_out,
+        } => {
+            let t = read_trace(&trace, rate)?;
             let strides = replay::replay(&t, Ranges::default())?;
             for s in &strides {
                 if json {
                     println!("{}", serde_json::to_string(s)?);
                 } else {
                     println!(
-                        "stride {:3} start {:8.3} s dur {:5.3} s length {:5.3} m valid {}",
-                        s.index, s.start_s, s.end_s - s.start_s, s.length_m, s.valid
+                        "stride {:3}  start {:8.3} s  dur {:5.3} s  length {:5.3} m  phases {:3.0}/{:3.0}/{:3.0}/{:3.0} ms{}",
+                        s.index,
+                        s.start_s,
+                        s.end_s - s.start_s,
+                        s.length_m,
+                        (s.heel_off_s - s.start_s) * 1e3,
+                        (s.toe_off_s - s.heel_off_s) * 1e3,
+                        (s.heel_strike_s - s.toe_off_s) * 1e3,
+                        (s.end_s - s.heel_strike_s) * 1e3,
+                        if s.valid { String::new() } else { format!("  INVALID ({})", s.flags.join(",")) }
                     );
                 }
             }
             let total: f64 = strides.iter().map(|s| s.length_m).sum();
-            eprintln!("{} strides, {:.2} m", strides.len(), total);
+            eprintln!("{} strides, {:.3} m in total", strides.len(), total);
+            if let Some(out) = mcap_out {
+                let f = std::fs::File::create(&out)
+                    .with_context(|| format!("creating {}", out.display()))?;
+                mcap_io::write(std::io::BufWriter::new(f), &t.samples, &strides)?;
+                eprintln!("wrote {}", out.display());
+            }
         }
         Cmd::Simulate { out } => {
             fixtures::write_all(&out)?;

@@ -1,0 +1,334 @@
+//! MCAP traces: IMU samples in gaitclip's own JSON schema or as ROS 2 `sensor_msgs/msg/Imu`
+//! (CDR), and writing a trace together with its strides so both open in Foxglove.
+
+use std::collections::BTreeMap;
+use std::fs;
+use std::io::{Seek, Write};
+use std::path::{Path, PathBuf};
+
+use serde::{Deserialize, Serialize};
+
+use crate::replay::StrideReport;
+use crate::trace::{ImuSample, Trace};
+
+/// Schema name of gaitclip's own IMU messages (JSON).
+pub const IMU_SCHEMA: &str = "gaitclip.ImuSample";
+/// Schema name of gaitclip's stride messages (JSON).
+pub const STRIDE_SCHEMA: &str = "gaitclip.Stride";
+/// Schema name of ROS 2 IMU messages.
+pub const ROS2_IMU_SCHEMA: &str = "sensor_msgs/msg/Imu";
+/// Topic gaitclip writes samples to.
+pub const IMU_TOPIC: &str = "/imu";
+/// Topic gaitclip writes strides to.
+pub const STRIDE_TOPIC: &str = "/strides";
+
+const IMU_JSON_SCHEMA: &str = r#"{"type":"object","title":"gaitclip.ImuSample","properties":{"t_s":{"type":"number","description":"time, s"},"acc":{"type":"array","items":{"type":"number"},"description":"specific force x,y,z, m/s^2, sensor axes"},"gyr":{"type":"array","items":{"type":"number"},"description":"angular rate x,y,z, rad/s"}}}"#;
+const STRIDE_JSON_SCHEMA: &str = r#"{"type":"object","title":"gaitclip.Stride","properties":{"index":{"type":"integer"},"start_s":{"type":"number"},"end_s":{"type":"number"},"length_m":{"type":"number"},"heel_off_s":{"type":"number"},"toe_off_s":{"type":"number"},"heel_strike_s":{"type":"number"},"foot_flat_s":{"type":"number"},"climb_m":{"type":"number"},"valid":{"type":"boolean"},"flags":{"type":"array","items":{"type":"string"}}}}"#;
+
+/// gaitclip's IMU message.
+#[derive(Serialize, Deserialize)]
+struct ImuJson {
+    t_s: f64,
+    acc: [f64; 3],
+    gyr: [f64; 3],
+}
+
+/// What went wrong with an MCAP trace.
+#[derive(Debug, thiserror::Error)]
+pub enum McapError {
+    /// Reading or writing the file.
+    #[error("{path}: {source}")]
+    Io {
+        /// The file.
+        path: PathBuf,
+        /// The cause.
+        source: std::io::Error,
+    },
+    /// The file is not valid MCAP.
+    #[error("{path}: not a readable MCAP file: {source}")]
+    Format {
+        /// The file.
+        path: PathBuf,
+        /// The parser's error.
+        source: mcap::McapError,
+    },
+    /// No channel carries IMU samples.
+    #[error("{path}: no IMU channel (schema `{IMU_SCHEMA}` or `{ROS2_IMU_SCHEMA}` with CDR); channels seen: {seen}")]
+    NoImuChannel {
+        /// The file.
+        path: PathBuf,
+        /// `topic (schema, encoding)` of each channel.
+        seen: String,
+    },
+    /// A message on the IMU channel does not decode.
+    #[error("{path}: message {index} on `{topic}`: {message}")]
+    BadMessage {
+        /// The file.
+        path: PathBuf,
+        /// 0-based index among the IMU messages.
+        index: usize,
+        /// The topic.
+        topic: String,
+        /// What is wrong.
+        message: String,
+    },
+    /// Writing failed.
+    #[error("writing MCAP: {0}")]
+    Write(mcap::McapError),
+}
+
+#[derive(Clone, Copy, PartialEq)]
+enum ImuKind {
+    Json,
+    Ros2Cdr,
+}
+
+fn imu_kind(ch: &mcap::Channel<'_>) -> Option<ImuKind> {
+    let schema = ch.schema.as_ref()?;
+    match (schema.name.as_str(), ch.message_encoding.as_str()) {
+        (IMU_SCHEMA, "json") => Some(ImuKind::Json),
+        (ROS2_IMU_SCHEMA, "cdr") => Some(ImuKind::Ros2Cdr),
+        _ => None,
+    }
+}
+
+/// Reads the IMU samples of the first IMU channel (by channel id) of an MCAP file. The rate
+/// is `rate_hz` if given, else the median interval of the timestamps.
+pub fn read(path: &Path, rate_hz: Option<f64>) -> Result<Trace, McapError> {
+    let bytes = fs::read(path).map_err(|source| McapError::Io {
+        path: path.to_owned(),
+        source,
+    })?;
+    let fmt = |source| McapError::Format {
+        path: path.to_owned(),
+        source,
+    };
+    let mut channels: BTreeMap<u16, (String, String, String)> = BTreeMap::new();
+    let mut chosen: Option<(u16, ImuKind)> = None;
+    let mut samples = Vec::new();
+    for msg in mcap::MessageStream::new(&bytes).map_err(fmt)? {
+        let msg = msg.map_err(fmt)?;
+        let ch = &msg.channel;
+        channels.entry(ch.id).or_insert_with(|| {
+            let schema = ch.schema.as_ref().map_or("no schema".to_owned(), |s| s.name.clone());
+            (ch.topic.clone(), schema, ch.message_encoding.clone())
+        });
+        if chosen.is_none() {
+            chosen = imu_kind(ch).map(|k| (ch.id, k));
+        }
+        let Some((id, kind)) = chosen else { continue };
+        if ch.id != id {
+            continue;
+        }
+        let bad = |message: String| McapError::BadMessage {
+            path: path.to_owned(),
+            index: samples.len(),
+            topic: ch.topic.clone(),
+            message,
+        };
+        let s = match kind {
+            ImuKind::Json => {
+                let j: ImuJson = serde_json::from_slice(&msg.data).map_err(|e| bad(e.to_string()))?;
+                ImuSample {
+                    t_s: j.t_s,
+                    acc_mps2: j.acc,
+                    gyr_radps: j.gyr,
+                }
+            }
+            ImuKind::Ros2Cdr => {
+                let mut s = decode_ros2_imu(&msg.data).map_err(bad)?;
+                if s.t_s == 0.0 {
+                    s.t_s = msg.log_time as f64 * 1e-9;
+                }
+                s
+            }
+        };
+        if !(s.t_s.is_finite()
+            && s.acc_mps2.iter().chain(&s.gyr_radps).all(|v| v.is_finite()))
+        {
+            return Err(bad("non-finite value".into()));
+        }
+        samples.push(s);
+    }
+    if samples.is_empty() {
+        let seen = if channels.is_empty() {
+            "none".to_owned()
+        } else {
+            channels
+                .values()
+                .map(|(t, s, e)| format!("{t} ({s}, {e})"))
+                .collect::<Vec<_>>()
+                .join(", ")
+        };
+        return Err(McapError::NoImuChannel {
+            path: path.to_owned(),
+            seen,
+        });
+    }
+    let rate_hz = rate_hz
+        .or_else(|| Trace::rate_from_timestamps(&samples))
+        .unwrap_or(0.0);
+    Ok(Trace { samples, rate_hz })
+}
+
+/// Decodes a CDR-encoded ROS 2 `sensor_msgs/msg/Imu`: header stamp, frame id, orientation
+/// and covariances are skipped except the stamp; angular velocity and linear acceleration
+/// are read. Both little- and big-endian CDR are accepted.
+pub fn decode_ros2_imu(data: &[u8]) -> Result<ImuSample, String> {
+    let mut c = Cdr::new(data)?;
+    let sec = c.u32()? as i32;
+    let nanosec = c.u32()?;
+    let len = c.u32()? as usize;
+    c.skip(len)?; // frame_id, with its NUL
+    let mut f = |n: usize| -> Result<Vec<f64>, String> { (0..n).map(|_| c.f64()).collect() };
+    let _orientation = f(4)?;
+    let _orientation_cov = f(9)?;
+    let w = f(3)?;
+    let _w_cov = f(9)?;
+    let a = f(3)?;
+    Ok(ImuSample {
+        t_s: sec as f64 + nanosec as f64 * 1e-9,
+        acc_mps2: [a[0], a[1], a[2]],
+        gyr_radps: [w[0], w[1], w[2]],
+    })
+}
+
+/// Encodes a ROS 2 `sensor_msgs/msg/Imu` as little-endian CDR (orientation unknown:
+/// covariance[0] = −1 as REP 145 says).
+pub fn encode_ros2_imu(s: &ImuSample, frame_id: &str) -> Vec<u8> {
+    let mut b = vec![0x00, 0x01, 0x00, 0x00];
+    let sec = s.t_s.floor();
+    b.extend_from_slice(&(sec as i32).to_le_bytes());
+    b.extend_from_slice(&(((s.t_s - sec) * 1e9).round() as u32).to_le_bytes());
+    b.extend_from_slice(&(frame_id.len() as u32 + 1).to_le_bytes());
+    b.extend_from_slice(frame_id.as_bytes());
+    b.push(0);
+    let put = |b: &mut Vec<u8>, v: f64| {
+        while (b.len() - 4) % 8 != 0 {
+            b.push(0);
+        }
+        b.extend_from_slice(&v.to_le_bytes());
+    };
+    for v in [0.0, 0.0, 0.0, 1.0] {
+        put(&mut b, v);
+    }
+    for k in 0..9 {
+        put(&mut b, if k == 0 { -1.0 } else { 0.0 });
+    }
+    for v in s.gyr_radps {
+        put(&mut b, v);
+    }
+    for _ in 0..9 {
+        put(&mut b, 0.0);
+    }
+    for v in s.acc_mps2 {
+        put(&mut b, v);
+    }
+    for _ in 0..9 {
+        put(&mut b, 0.0);
+    }
+    b
+}
+
+struct Cdr<'a> {
+    body: &'a [u8],
+    pos: usize,
+    little: bool,
+}
+
+impl<'a> Cdr<'a> {
+    fn new(data: &'a [u8]) -> Result<Self, String> {
+        let little = match data.get(..2) {
+            Some([0x00, 0x01]) | Some([0x00, 0x03]) => true,
+            Some([0x00, 0x00]) | Some([0x00, 0x02]) => false,
+            _ => return Err("not a CDR encapsulation header".into()),
+        };
+        Ok(Cdr {
+            body: &data[4.min(data.len())..],
+            pos: 0,
+            little,
+        })
+    }
+    fn take<const N: usize>(&mut self) -> Result<[u8; N], String> {
+        self.pos = self.pos.div_ceil(N) * N;
+        let s = self
+            .body
+            .get(self.pos..self.pos + N)
+            .ok_or_else(|| format!("truncated at byte {}", self.pos + 4))?;
+        self.pos += N;
+        let mut a = [0u8; N];
+        a.copy_from_slice(s);
+        if !self.little {
+            a.reverse();
+        }
+        Ok(a)
+    }
+    fn u32(&mut self) -> Result<u32, String> {
+        Ok(u32::from_le_bytes(self.take::<4>()?))
+    }
+    fn f64(&mut self) -> Result<f64, String> {
+        Ok(f64::from_le_bytes(self.take::<8>()?))
+    }
+    fn skip(&mut self, n: usize) -> Result<(), String> {
+        if self.pos + n > self.body.len() {
+            return Err(format!("string runs past the end (length {n})"));
+        }
+        self.pos += n;
+        Ok(())
+    }
+}
+
+fn ns(t_s: f64) -> u64 {
+    (t_s.max(0.0) * 1e9).round() as u64
+}
+
+/// Writes `samples` on [`IMU_TOPIC`] and one message per stride on [`STRIDE_TOPIC`].
+pub fn write<W: Write + Seek>(
+    w: W,
+    samples: &[ImuSample],
+    strides: &[StrideReport],
+) -> Result<(), McapError> {
+    let e = McapError::Write;
+    let mut out = mcap::WriteOptions::new()
+        .library("gaitclip")
+        .create(w)
+        .map_err(e)?;
+    let meta = BTreeMap::new();
+    let imu_schema = out
+        .add_schema(IMU_SCHEMA, "jsonschema", IMU_JSON_SCHEMA.as_bytes())
+        .map_err(e)?;
+    let imu = out.add_channel(imu_schema, IMU_TOPIC, "json", &meta).map_err(e)?;
+    let stride_schema = out
+        .add_schema(STRIDE_SCHEMA, "jsonschema", STRIDE_JSON_SCHEMA.as_bytes())
+        .map_err(e)?;
+    let st = out
+        .add_channel(stride_schema, STRIDE_TOPIC, "json", &meta)
+        .map_err(e)?;
+    for (i, s) in samples.iter().enumerate() {
+        let data = serde_json::to_vec(&ImuJson {
+            t_s: s.t_s,
+            acc: s.acc_mps2,
+            gyr: s.gyr_radps,
+        })
+        .map_err(|x| McapError::Write(mcap::McapError::Io(x.into())))?;
+        let h = mcap::records::MessageHeader {
+            channel_id: imu,
+            sequence: i as u32,
+            log_time: ns(s.t_s),
+            publish_time: ns(s.t_s),
+        };
+        out.write_to_known_channel(&h, &data).map_err(e)?;
+    }
+    for s in strides {
+        let data = serde_json::to_vec(s).map_err(|x| McapError::Write(mcap::McapError::Io(x.into())))?;
+        let h = mcap::records::MessageHeader {
+            channel_id: st,
+            sequence: s.index,
+            log_time: ns(s.end_s),
+            publish_time: ns(s.end_s),
+        };
+        out.write_to_known_channel(&h, &data).map_err(e)?;
+    }
+    out.finish().map_err(e)?;
+    Ok(())
+}
