@@ -9,3 +9,5 @@ pub mod qemu;
 pub mod sim;
 pub mod fixtures;
 pub mod mcap_io;
+pub mod firmware;
+pub mod datasets;

@@ -1,0 +1,72 @@
+//! Builds the firmware of the top-level crate and parses its stride log, for tests that
+//! compare it with the host replay.
+
+use std::path::{Path, PathBuf};
+use std::process::Command;
+
+use anyhow::{bail, Context};
+
+/// The repository root (the firmware crate).
+pub fn repo_root() -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("..")
+}
+
+/// Builds `bin` for `target` in release mode and returns the ELF path.
+pub fn build(bin: &str, target: &str) -> anyhow::Result<PathBuf> {
+    let root = repo_root();
+    let status = Command::new(std::env::var("CARGO").unwrap_or_else(|_| "cargo".into()))
+        .current_dir(&root)
+        .env_remove("CARGO_BUILD_TARGET")
+        .env_remove("RUSTFLAGS")
+        .env_remove("CARGO_ENCODED_RUSTFLAGS")
+        .env_remove("CARGO_TARGET_DIR")
+        .args(["build", "--release", "--bin", bin, "--target", target])
+        .status()
+        .context("running cargo build for the firmware")?;
+    if !status.success() {
+        bail!("firmware build failed ({status})");
+    }
+    Ok(root.join("target").join(target).join("release").join(bin))
+}
+
+/// The integers of one `stride …` log line.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct LoggedStride {
+    /// Stride index.
+    pub index: u32,
+    /// start, heel_off, toe_off, heel_strike, end sample indices.
+    pub idx: [u32; 5],
+    /// Length, mm.
+    pub length_mm: u32,
+    /// Climb, mm.
+    pub climb_mm: i32,
+    /// Flag bits.
+    pub flags: u8,
+}
+
+/// Parses a line written by `boards/common/stride_log.rs`; `None` for other lines.
+pub fn parse_stride_line(line: &str) -> Option<LoggedStride> {
+    let rest = line.strip_prefix("stride ")?;
+    let mut fields = rest.split_whitespace();
+    let index = fields.next()?.parse().ok()?;
+    let (mut len, mut climb, mut flags, mut idx) = (None, None, None, None);
+    for f in fields {
+        if let Some(v) = f.strip_prefix("len=") {
+            len = v.parse().ok();
+        } else if let Some(v) = f.strip_prefix("climb=") {
+            climb = v.parse().ok();
+        } else if let Some(v) = f.strip_prefix("flags=") {
+            flags = v.parse().ok();
+        } else if let Some(v) = f.strip_prefix("idx=") {
+            let v: Vec<u32> = v.split(',').filter_map(|x| x.parse().ok()).collect();
+            idx = v.try_into().ok();
+        }
+    }
+    Some(LoggedStride {
+        index,
+        idx: idx?,
+        length_mm: len?,
+        climb_mm: climb?,
+        flags: flags?,
+    })
+}

@@ -1,0 +1,51 @@
+//! A malformed CSV names its file, line and column; a missing column is named.
+
+use std::path::Path;
+
+use gaitclip_host::csv_trace::{parse, CsvError};
+
+const HEADER: &str = "t_s,acc_x,acc_y,acc_z,gyr_x,gyr_y,gyr_z\n";
+
+#[test]
+fn bad_number_names_file_line_and_column() {
+    let text = format!("{HEADER}0,1,2,3,4,5,6\n0.005,1,2,abc,4,5,6\n");
+    let e = parse(Path::new("walk.csv"), text.as_bytes()).unwrap_err();
+    assert!(matches!(e, CsvError::BadNumber { line: 3, col: 4, .. }), "{e:?}");
+    assert_eq!(e.to_string(), "walk.csv:3:4: column `acc_z`: `abc` is not a finite number");
+}
+
+#[test]
+fn non_finite_values_are_rejected() {
+    let text = format!("{HEADER}0,1,2,3,NaN,5,6\n");
+    let e = parse(Path::new("w.csv"), text.as_bytes()).unwrap_err();
+    assert!(e.to_string().starts_with("w.csv:2:5:"), "{e}");
+}
+
+#[test]
+fn missing_column_is_named() {
+    let text = "t_s,acc_x,acc_y,acc_z,gyr_x,gyr_y\n0,1,2,3,4,5\n";
+    let e = parse(Path::new("w.csv"), text.as_bytes()).unwrap_err();
+    assert!(e.to_string().contains("missing column `gyr_z`"), "{e}");
+}
+
+#[test]
+fn short_row_names_its_line() {
+    let text = format!("{HEADER}0,1,2,3,4,5,6\n0.005,1,2\n");
+    let e = parse(Path::new("w.csv"), text.as_bytes()).unwrap_err();
+    assert!(e.to_string().starts_with("w.csv:3:"), "{e}");
+}
+
+#[test]
+fn columns_in_any_order_and_extra_columns_are_fine() {
+    let text = "gyr_z,extra,t_s,acc_x,acc_y,acc_z,gyr_x,gyr_y\n6,x,0.5,1,2,3,4,5\n";
+    let s = parse(Path::new("w.csv"), text.as_bytes()).unwrap();
+    assert_eq!(s[0].t_s, 0.5);
+    assert_eq!(s[0].acc_mps2, [1.0, 2.0, 3.0]);
+    assert_eq!(s[0].gyr_radps, [4.0, 5.0, 6.0]);
+}
+
+#[test]
+fn header_only_is_empty() {
+    let e = parse(Path::new("w.csv"), HEADER.as_bytes()).unwrap_err();
+    assert_eq!(e.to_string(), "w.csv: no samples");
+}

@@ -1,0 +1,65 @@
+//! Bit-exact end to end: the firmware on the emulated Cortex-M4 (QEMU mps2-an386), replaying
+//! the demo fixture from flash through the emulated sensor bus and the real driver, logs the
+//! same per-stride integers as the host replay of the same fixture.
+
+use gaitclip::rate::SampleRate;
+use gaitclip::sample::RawSample;
+use gaitclip_host::firmware::{self, parse_stride_line, LoggedStride};
+use gaitclip_host::fixtures::FIRMWARE_TRACE;
+use gaitclip_host::qemu::{self, RunOptions};
+use gaitclip_host::replay::replay_counts;
+use gaitclip_host::trace::Ranges;
+
+fn qemu_available() -> bool {
+    std::process::Command::new("qemu-system-arm")
+        .arg("--version")
+        .output()
+        .is_ok_and(|o| o.status.success())
+}
+
+#[test]
+fn qemu_m4_strides_equal_host_replay() {
+    if !qemu_available() {
+        if std::env::var("CI").is_ok_and(|v| v == "true") {
+            panic!("qemu-system-arm is missing in CI (apt-get install qemu-system-arm)");
+        }
+        eprintln!("SKIPPED: qemu-system-arm is not installed");
+        return;
+    }
+    let elf = firmware::build("mps2-an386", "thumbv7em-none-eabihf").expect("firmware builds");
+    let out = qemu::run(
+        &elf,
+        &RunOptions {
+            machine: qemu::MACHINE_M4.into(),
+            fast: true,
+        },
+        |_| {},
+    )
+    .expect("qemu runs");
+    assert_eq!(out.status, 0, "firmware exit status; log:\n{}", out.lines.join("\n"));
+    let on_target: Vec<LoggedStride> = out.lines.iter().filter_map(|l| parse_stride_line(l)).collect();
+
+    let bytes = std::fs::read(firmware::repo_root().join(format!("fixtures/{FIRMWARE_TRACE}.mpu6050"))).unwrap();
+    let counts: Vec<RawSample> = bytes
+        .chunks_exact(14)
+        .map(|c| RawSample::from_be_bytes(c.try_into().unwrap()))
+        .collect();
+    let host: Vec<LoggedStride> = replay_counts(&counts, SampleRate::from_hz(200).unwrap(), Ranges::default(), |i| i as f64)
+        .iter()
+        .map(|s| LoggedStride {
+            index: s.raw.index,
+            idx: [s.raw.start, s.raw.heel_off, s.raw.toe_off, s.raw.heel_strike, s.raw.end],
+            length_mm: s.raw.length_mm,
+            climb_mm: s.raw.climb_mm,
+            flags: s.raw.flags.0,
+        })
+        .collect();
+    assert!(host.len() >= 20, "host found {} strides", host.len());
+    assert_eq!(on_target, host);
+
+    let summary = out.lines.iter().find(|l| l.starts_with("summary")).expect("summary line");
+    assert!(summary.contains(&format!("strides={}", host.len())), "{summary}");
+    assert!(summary.contains(&format!("samples={}", counts.len())), "{summary}");
+    assert!(summary.contains("overruns=0"), "{summary}");
+    assert!(summary.contains("bus_errors=0"), "{summary}");
+}

@@ -1,0 +1,74 @@
+//! The committed fixtures are what the simulator makes today, and the core finds their
+//! strides, events and lengths.
+
+use std::path::PathBuf;
+
+use gaitclip::rate::SampleRate;
+use gaitclip::sample::RawSample;
+use gaitclip_host::fixtures::{self, FIRMWARE_TRACE};
+use gaitclip_host::replay::{replay, replay_counts};
+use gaitclip_host::sim;
+use gaitclip_host::trace::Ranges;
+use gaitclip_host::csv_trace;
+
+fn dir() -> PathBuf {
+    PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../fixtures")
+}
+
+#[test]
+fn committed_fixtures_are_not_stale() {
+    let tmp = std::env::temp_dir().join(format!("gaitclip-fixtures-{}", std::process::id()));
+    fixtures::write_all(&tmp).unwrap();
+    for name in fixtures::file_names() {
+        let fresh = std::fs::read(tmp.join(&name)).unwrap();
+        let committed = std::fs::read(dir().join(&name))
+            .unwrap_or_else(|e| panic!("fixtures/{name}: {e}; regenerate with `cargo run --release -- simulate`"));
+        assert!(
+            fresh == committed,
+            "fixtures/{name} is stale: regenerate with `cd tests-host && cargo run --release -- simulate`"
+        );
+    }
+    let _ = std::fs::remove_dir_all(&tmp);
+}
+
+#[test]
+fn csv_and_register_dump_hold_the_same_counts() {
+    let trace = csv_trace::read(&dir().join(format!("{FIRMWARE_TRACE}.csv")), None).unwrap();
+    let bytes = std::fs::read(dir().join(format!("{FIRMWARE_TRACE}.mpu6050"))).unwrap();
+    let counts: Vec<RawSample> = bytes.chunks_exact(14).map(|c| RawSample::from_be_bytes(c.try_into().unwrap())).collect();
+    assert_eq!(trace.samples.len(), counts.len());
+    let r = Ranges::default();
+    for (s, c) in trace.samples.iter().zip(&counts) {
+        assert_eq!(r.to_counts(s), *c);
+    }
+    // And the replay of either gives the same strides.
+    let a = replay(&trace, r).unwrap();
+    let b = replay_counts(&counts, SampleRate::from_hz(200).unwrap(), r, |i| trace.samples[i as usize].t_s);
+    assert_eq!(a, b);
+}
+
+/// Every stride of every scenario is found, in order, with no extra strides: heel-off and
+/// foot-flat within 40 ms, toe-off and heel-strike within 60 ms of the simulator's events, and
+/// the length within 3 % + 2 cm. Flagged strides (first, last, turns; turning on the spot is a
+/// slow shuffle whose ends barely move) get three times the timing tolerance and 5 cm on length.
+#[test]
+fn replay_finds_simulated_strides() {
+    for sc in sim::scenarios() {
+        let trace = csv_trace::read(&dir().join(format!("{}.csv", sc.name)), None).unwrap();
+        let truth = sim::simulate(&sc, Ranges::default()).truth;
+        let got = replay(&trace, Ranges::default()).unwrap();
+        assert_eq!(got.len(), truth.len(), "{}: stride count", sc.name);
+        let t = |i: u32| i as f64 / sc.rate_hz;
+        for (g, w) in got.iter().zip(&truth) {
+            let ctx = format!("{} stride {}", sc.name, w.stride);
+            let k = if w.flag.is_empty() { 1.0 } else { 3.0 };
+            let len_tol = if w.flag.is_empty() { 0.03 * w.length_m + 0.02 } else { 0.05 };
+            assert!((g.heel_off_s - t(w.heel_off_idx)).abs() <= 0.04 * k, "{ctx}: heel-off {} vs {}", g.heel_off_s, t(w.heel_off_idx));
+            assert!((g.foot_flat_s - t(w.end_idx)).abs() <= 0.04 * k, "{ctx}: foot-flat {} vs {}", g.foot_flat_s, t(w.end_idx));
+            assert!((g.toe_off_s - t(w.toe_off_idx)).abs() <= 0.06 * k, "{ctx}: toe-off {} vs {}", g.toe_off_s, t(w.toe_off_idx));
+            assert!((g.heel_strike_s - t(w.heel_strike_idx)).abs() <= 0.06 * k, "{ctx}: heel-strike {} vs {}", g.heel_strike_s, t(w.heel_strike_idx));
+            assert!((g.length_m - w.length_m).abs() <= len_tol, "{ctx}: length {} vs {}", g.length_m, w.length_m);
+            assert!(g.valid, "{ctx}: flagged {:?}", g.flags);
+        }
+    }
+}
