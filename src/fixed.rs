@@ -72,24 +72,6 @@ impl QuatQ30 {
         z: 0,
     };
 
-    /// Hamilton product `self ⊗ o`. Inputs of norm ≤ 1: error ≤ 2 LSB per component.
-    pub fn mul(self, o: QuatQ30) -> QuatQ30 {
-        let (a, b) = (self, o);
-        let m = |p: [i32; 4], q: [i32; 4]| -> i32 {
-            let s = p[0] as i64 * q[0] as i64
-                + p[1] as i64 * q[1] as i64
-                + p[2] as i64 * q[2] as i64
-                + p[3] as i64 * q[3] as i64;
-            shr_round(s, 30) as i32
-        };
-        QuatQ30 {
-            w: m([a.w, -a.x, -a.y, -a.z], [b.w, b.x, b.y, b.z]),
-            x: m([a.w, a.x, a.y, -a.z], [b.x, b.w, b.z, b.y]),
-            y: m([a.w, -a.x, a.y, a.z], [b.y, b.z, b.w, b.x]),
-            z: m([a.w, a.x, -a.y, a.z], [b.z, b.y, b.x, b.w]),
-        }
-    }
-
     /// Advances the attitude by body rates given as half-angle increments
     /// `h = ω·dt/2` (Q30 radians per axis, |h| ≤ 0.2): `q ← q + q ⊗ (0, h')`, then one Newton
     /// step of normalisation. The normalised first-order step turns by `2·atan|h'|`, not
@@ -99,8 +81,9 @@ impl QuatQ30 {
     /// the norm within 2⁻²⁶ (1.5e−8) of one.
     pub const fn integrate_half_angle(self, h: [i32; 3]) -> QuatQ30 {
         let (w, x, y, z) = (self.w as i64, self.x as i64, self.y as i64, self.z as i64);
-        let h2 = (h[0] as i64 * h[0] as i64 + h[1] as i64 * h[1] as i64 + h[2] as i64 * h[2] as i64)
-            >> 30;
+        let h2 =
+            (h[0] as i64 * h[0] as i64 + h[1] as i64 * h[1] as i64 + h[2] as i64 * h[2] as i64)
+                >> 30;
         let scale = Q30_ONE as i64 + h2 / 3;
         let (hx, hy, hz) = (
             shr_round(h[0] as i64 * scale, 30),
@@ -200,10 +183,7 @@ impl QuatQ30 {
                 y: 0,
                 z: 0,
             };
-            match QuatQ30::normalized([Q30_ONE as i64 - uz, -uy, -ux, 0]) {
-                Some(q) => Some(q.mul(flip)),
-                None => None,
-            }
+            QuatQ30::normalized([Q30_ONE as i64 - uz, -uy, -ux, 0]).map(|q| q * flip)
         }
     }
 
@@ -230,5 +210,27 @@ impl QuatQ30 {
                 e(one - 2 * (p(x, x) + p(y, y))),
             ],
         ]
+    }
+}
+
+impl core::ops::Mul for QuatQ30 {
+    type Output = QuatQ30;
+
+    /// Hamilton product `self ⊗ o`. Inputs of norm ≤ 1: error ≤ 2 LSB per component.
+    fn mul(self, o: QuatQ30) -> QuatQ30 {
+        let (a, b) = (self, o);
+        let m = |p: [i32; 4], q: [i32; 4]| -> i32 {
+            let s = p[0] as i64 * q[0] as i64
+                + p[1] as i64 * q[1] as i64
+                + p[2] as i64 * q[2] as i64
+                + p[3] as i64 * q[3] as i64;
+            shr_round(s, 30) as i32
+        };
+        QuatQ30 {
+            w: m([a.w, -a.x, -a.y, -a.z], [b.w, b.x, b.y, b.z]),
+            x: m([a.w, a.x, a.y, -a.z], [b.x, b.w, b.z, b.y]),
+            y: m([a.w, -a.x, a.y, a.z], [b.y, b.z, b.w, b.x]),
+            z: m([a.w, a.x, -a.y, a.z], [b.z, b.y, b.x, b.w]),
+        }
     }
 }

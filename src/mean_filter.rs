@@ -48,7 +48,12 @@ impl<const N: usize> MeanFilter<N> {
             self.filled += 1;
         }
         let mut out = [0i16; 3];
-        for ((s, (&new, &gone)), o) in self.sum.iter_mut().zip(x.iter().zip(old.iter())).zip(out.iter_mut()) {
+        for ((s, (&new, &gone)), o) in self
+            .sum
+            .iter_mut()
+            .zip(x.iter().zip(old.iter()))
+            .zip(out.iter_mut())
+        {
             // Slots not yet written hold 0, so subtracting them is harmless.
             *s += new as i32 - gone as i32;
             *o = if self.filled == N {

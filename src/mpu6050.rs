@@ -309,7 +309,8 @@ impl<I: I2c> Mpu6050<I> {
         let n = (count as usize / SAMPLE_BYTES).min(out.len());
         for slot in out.iter_mut().take(n) {
             let mut buf = [0u8; SAMPLE_BYTES];
-            self.i2c.write_read(self.address, &[reg::FIFO_R_W], &mut buf)?;
+            self.i2c
+                .write_read(self.address, &[reg::FIFO_R_W], &mut buf)?;
             *slot = RawSample::from_be_bytes(&buf);
         }
         Ok(n)

@@ -220,7 +220,10 @@ impl StrideTracker {
         let argmax = |xs: &[u32]| {
             xs.iter()
                 .enumerate()
-                .fold((0usize, 0u32), |best, (i, &v)| if v > best.1 { (i, v) } else { best })
+                .fold(
+                    (0usize, 0u32),
+                    |best, (i, &v)| if v > best.1 { (i, v) } else { best },
+                )
                 .0 as u32
         };
         let toe_off = self.heel_off + argmax(&self.magnitude[..half]);
@@ -244,8 +247,8 @@ impl StrideTracker {
             heel_strike,
             end: foot_flat,
             length_mm: ((d.horizontal_um + 500) / 1000).min(u32::MAX as u64) as u32,
-            climb_mm: ((d.vertical_um + 500).div_euclid(1000)).clamp(i32::MIN as i64, i32::MAX as i64)
-                as i32,
+            climb_mm: ((d.vertical_um + 500).div_euclid(1000))
+                .clamp(i32::MIN as i64, i32::MAX as i64) as i32,
             flags: StrideFlags(flags),
         }
     }

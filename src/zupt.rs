@@ -123,7 +123,9 @@ impl ZuptIntegrator {
     /// The displacement, with the residual end velocity removed as linear drift.
     pub fn displacement(&self) -> Displacement {
         let n = self.samples as i128;
-        let den = 2 * self.gravity_q8 as i128 * self.rate.millihertz() as i128
+        let den = 2
+            * self.gravity_q8 as i128
+            * self.rate.millihertz() as i128
             * self.rate.millihertz() as i128;
         let um = |i: usize| {
             // Trapezoidal position of a velocity error growing linearly to v_N over N samples

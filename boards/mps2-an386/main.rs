@@ -10,13 +10,13 @@
 #![no_std]
 #![no_main]
 
+mod cmsdk_timer;
 #[path = "../common/replay_mpu6050.rs"]
 mod replay_mpu6050;
 #[path = "../common/stride_log.rs"]
 mod stride_log;
 #[path = "../../fixtures/demo_walk.rs"]
 mod trace;
-mod cmsdk_timer;
 
 use core::cell::RefCell;
 use core::sync::atomic::{AtomicBool, AtomicU32, Ordering};
@@ -89,7 +89,8 @@ fn main() -> ! {
         ReplayMpu6050::new(Address::Ad0Low.bits(), trace::REGISTERS),
         Address::Ad0Low,
     );
-    let Some(out_rate) = mpu6050::OutputRate::from_hz((trace::RATE_MILLIHERTZ / 1000) as u16) else {
+    let Some(out_rate) = mpu6050::OutputRate::from_hz((trace::RATE_MILLIHERTZ / 1000) as u16)
+    else {
         defmt::error!("rate outside the sensor's 100-1000 Hz");
         fail();
     };
@@ -217,7 +218,6 @@ fn panic(info: &core::panic::PanicInfo) -> ! {
 
 fn fail() -> ! {
     debug::exit(EXIT_FAILURE);
-    loop {
-        cortex_m::asm::udf();
-    }
+    // Without a debugger attached semihosting returns: stop with a fault instead.
+    cortex_m::asm::udf()
 }

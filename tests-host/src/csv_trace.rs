@@ -103,10 +103,14 @@ fn meta_rate(csv: &Path) -> Result<Option<f64>, CsvError> {
     })?;
     match v.get("sample_rate_hz") {
         None => Ok(None),
-        Some(r) => r.as_f64().filter(|r| *r > 0.0).map(Some).ok_or(CsvError::Meta {
-            path: meta,
-            message: format!("sample_rate_hz is not a positive number: {r}"),
-        }),
+        Some(r) => r
+            .as_f64()
+            .filter(|r| *r > 0.0)
+            .map(Some)
+            .ok_or(CsvError::Meta {
+                path: meta,
+                message: format!("sample_rate_hz is not a positive number: {r}"),
+            }),
     }
 }
 

@@ -3,11 +3,11 @@
 //! firmware in QEMU with its defmt log decoded.
 
 pub mod csv_trace;
-pub mod replay;
-pub mod trace;
-pub mod qemu;
-pub mod sim;
+pub mod datasets;
+pub mod firmware;
 pub mod fixtures;
 pub mod mcap_io;
-pub mod firmware;
-pub mod datasets;
+pub mod qemu;
+pub mod replay;
+pub mod sim;
+pub mod trace;

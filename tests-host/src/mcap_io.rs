@@ -110,7 +110,10 @@ pub fn read(path: &Path, rate_hz: Option<f64>) -> Result<Trace, McapError> {
         let msg = msg.map_err(fmt)?;
         let ch = &msg.channel;
         channels.entry(ch.id).or_insert_with(|| {
-            let schema = ch.schema.as_ref().map_or("no schema".to_owned(), |s| s.name.clone());
+            let schema = ch
+                .schema
+                .as_ref()
+                .map_or("no schema".to_owned(), |s| s.name.clone());
             (ch.topic.clone(), schema, ch.message_encoding.clone())
         });
         if chosen.is_none() {
@@ -128,7 +131,8 @@ pub fn read(path: &Path, rate_hz: Option<f64>) -> Result<Trace, McapError> {
         };
         let s = match kind {
             ImuKind::Json => {
-                let j: ImuJson = serde_json::from_slice(&msg.data).map_err(|e| bad(e.to_string()))?;
+                let j: ImuJson =
+                    serde_json::from_slice(&msg.data).map_err(|e| bad(e.to_string()))?;
                 ImuSample {
                     t_s: j.t_s,
                     acc_mps2: j.acc,
@@ -143,9 +147,7 @@ pub fn read(path: &Path, rate_hz: Option<f64>) -> Result<Trace, McapError> {
                 s
             }
         };
-        if !(s.t_s.is_finite()
-            && s.acc_mps2.iter().chain(&s.gyr_radps).all(|v| v.is_finite()))
-        {
+        if !(s.t_s.is_finite() && s.acc_mps2.iter().chain(&s.gyr_radps).all(|v| v.is_finite())) {
             return Err(bad("non-finite value".into()));
         }
         samples.push(s);
@@ -297,7 +299,9 @@ pub fn write<W: Write + Seek>(
     let imu_schema = out
         .add_schema(IMU_SCHEMA, "jsonschema", IMU_JSON_SCHEMA.as_bytes())
         .map_err(e)?;
-    let imu = out.add_channel(imu_schema, IMU_TOPIC, "json", &meta).map_err(e)?;
+    let imu = out
+        .add_channel(imu_schema, IMU_TOPIC, "json", &meta)
+        .map_err(e)?;
     let stride_schema = out
         .add_schema(STRIDE_SCHEMA, "jsonschema", STRIDE_JSON_SCHEMA.as_bytes())
         .map_err(e)?;
@@ -320,7 +324,8 @@ pub fn write<W: Write + Seek>(
         out.write_to_known_channel(&h, &data).map_err(e)?;
     }
     for s in strides {
-        let data = serde_json::to_vec(s).map_err(|x| McapError::Write(mcap::McapError::Io(x.into())))?;
+        let data =
+            serde_json::to_vec(s).map_err(|x| McapError::Write(mcap::McapError::Io(x.into())))?;
         let h = mcap::records::MessageHeader {
             channel_id: st,
             sequence: s.index,

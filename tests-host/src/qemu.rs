@@ -29,14 +29,26 @@ pub struct RunOutput {
 }
 
 /// Runs `elf`, calling `on_line` for each decoded log line as it arrives.
-pub fn run(elf: &Path, opts: &RunOptions, mut on_line: impl FnMut(&str)) -> anyhow::Result<RunOutput> {
+pub fn run(
+    elf: &Path,
+    opts: &RunOptions,
+    mut on_line: impl FnMut(&str),
+) -> anyhow::Result<RunOutput> {
     let bytes = std::fs::read(elf).with_context(|| format!("reading {}", elf.display()))?;
     let table = defmt_decoder::Table::parse(&bytes)
         .with_context(|| format!("reading the defmt table of {}", elf.display()))?
         .with_context(|| format!("{} has no defmt data", elf.display()))?;
     let mut cmd = Command::new("qemu-system-arm");
-    cmd.args(["-M", &opts.machine, "-nographic", "-monitor", "none", "-serial", "none"])
-        .args(["-semihosting-config", "enable=on,target=native"]);
+    cmd.args([
+        "-M",
+        &opts.machine,
+        "-nographic",
+        "-monitor",
+        "none",
+        "-serial",
+        "none",
+    ])
+    .args(["-semihosting-config", "enable=on,target=native"]);
     if opts.fast {
         cmd.args(["-icount", "shift=0,sleep=off"]);
     }

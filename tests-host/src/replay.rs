@@ -81,7 +81,9 @@ pub fn replay_counts(
 
 /// Replays a trace in physical units: converts to counts at `ranges` (with saturation) first.
 pub fn replay(trace: &Trace, ranges: Ranges) -> Result<Vec<StrideReport>, ReplayError> {
-    let rate = trace.sample_rate().ok_or(ReplayError::Rate(trace.rate_hz))?;
+    let rate = trace
+        .sample_rate()
+        .ok_or(ReplayError::Rate(trace.rate_hz))?;
     let counts: Vec<RawSample> = trace.samples.iter().map(|s| ranges.to_counts(s)).collect();
     let times: Vec<f64> = trace.samples.iter().map(|s| s.t_s).collect();
     let dt = 1.0 / trace.rate_hz;

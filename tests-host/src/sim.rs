@@ -251,8 +251,10 @@ pub fn simulate(sc: &Scenario, ranges: Ranges) -> Simulated {
     let mount_t = transpose(&mount);
     let acc_noise = Normal::new(0.0, ACC_NOISE_MPS2).expect("valid sigma");
     let gyr_noise = Normal::new(0.0, GYR_NOISE_RADPS).expect("valid sigma");
-    let acc_bias: [f64; 3] = [0; 3].map(|_| rng.random_range(-ACC_BIAS_MAX_MPS2..ACC_BIAS_MAX_MPS2));
-    let gyr_bias: [f64; 3] = [0; 3].map(|_| rng.random_range(-GYR_BIAS_MAX_RADPS..GYR_BIAS_MAX_RADPS));
+    let acc_bias: [f64; 3] =
+        [0; 3].map(|_| rng.random_range(-ACC_BIAS_MAX_MPS2..ACC_BIAS_MAX_MPS2));
+    let gyr_bias: [f64; 3] =
+        [0; 3].map(|_| rng.random_range(-GYR_BIAS_MAX_RADPS..GYR_BIAS_MAX_RADPS));
     let rest = ([0.0, 0.0], 0.0);
     let foot_rot = |t: f64| {
         let (_, pitch, yaw) = pose(&moves, rest, t);
@@ -280,7 +282,7 @@ pub fn simulate(sc: &Scenario, ranges: Ranges) -> Simulated {
             }
         }
         acc_n[2] += G_MPS2; // specific force: the ground pushes up at rest
-        // Body rate from the rotation's derivative: [ω]× = Rᵀ·dR/dt.
+                            // Body rate from the rotation's derivative: [ω]× = Rᵀ·dR/dt.
         let (rm, rp) = (foot_rot(t - h), foot_rot(t + h));
         let mut dr = [[0.0; 3]; 3];
         for a in 0..3 {

@@ -10,8 +10,21 @@ const HEADER: &str = "t_s,acc_x,acc_y,acc_z,gyr_x,gyr_y,gyr_z\n";
 fn bad_number_names_file_line_and_column() {
     let text = format!("{HEADER}0,1,2,3,4,5,6\n0.005,1,2,abc,4,5,6\n");
     let e = parse(Path::new("walk.csv"), text.as_bytes()).unwrap_err();
-    assert!(matches!(e, CsvError::BadNumber { line: 3, col: 4, .. }), "{e:?}");
-    assert_eq!(e.to_string(), "walk.csv:3:4: column `acc_z`: `abc` is not a finite number");
+    assert!(
+        matches!(
+            e,
+            CsvError::BadNumber {
+                line: 3,
+                col: 4,
+                ..
+            }
+        ),
+        "{e:?}"
+    );
+    assert_eq!(
+        e.to_string(),
+        "walk.csv:3:4: column `acc_z`: `abc` is not a finite number"
+    );
 }
 
 #[test]

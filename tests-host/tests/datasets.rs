@@ -2,10 +2,10 @@
 //! in CI). Issue-2 level checks: the chain finds the strides of a real walk and measures them
 //! to within a few percent.
 
+use gaitclip_host::csv_trace;
 use gaitclip_host::datasets::root_or_skip;
 use gaitclip_host::replay::replay;
 use gaitclip_host::trace::Ranges;
-use gaitclip_host::csv_trace;
 
 #[derive(Debug)]
 struct RefStride {
@@ -19,7 +19,13 @@ fn reference(root: &std::path::Path, trial: &str, rate: f64) -> Vec<RefStride> {
     let mut rdr = csv::Reader::from_path(root.join("gaitmap_walk/strides.csv")).unwrap();
     let h = rdr.headers().unwrap().clone();
     let col = |n: &str| h.iter().position(|x| x == n).unwrap();
-    let (t, s, e, l, f) = (col("trial"), col("start_idx"), col("end_idx"), col("length_m"), col("flag"));
+    let (t, s, e, l, f) = (
+        col("trial"),
+        col("start_idx"),
+        col("end_idx"),
+        col("length_m"),
+        col("flag"),
+    );
     rdr.records()
         .map(|r| r.unwrap())
         .filter(|r| &r[t] == trial)
@@ -37,7 +43,9 @@ fn reference(root: &std::path::Path, trial: &str, rate: f64) -> Vec<RefStride> {
 /// matched clean strides is within 5 % of the Vicon sum.
 #[test]
 fn gaitmap_walk_strides_and_lengths() {
-    let Some(root) = root_or_skip("gaitmap_walk_strides_and_lengths") else { return };
+    let Some(root) = root_or_skip("gaitmap_walk_strides_and_lengths") else {
+        return;
+    };
     for trial in ["left", "right"] {
         let trace = csv_trace::read(&root.join(format!("gaitmap_walk/{trial}.csv")), None).unwrap();
         let t0 = trace.samples[0].t_s;
@@ -58,13 +66,23 @@ fn gaitmap_walk_strides_and_lengths() {
                 panic!("{trial}: reference stride at {:.2} s not found", r.start_s)
             };
             let rel = (g.length_m - r.length_m).abs() / r.length_m;
-            assert!(rel < 0.12, "{trial}: stride at {:.2} s: {} m vs {} m", r.start_s, g.length_m, r.length_m);
+            assert!(
+                rel < 0.12,
+                "{trial}: stride at {:.2} s: {} m vs {} m",
+                r.start_s,
+                g.length_m,
+                r.length_m
+            );
             sum_ref += r.length_m;
             sum_got += g.length_m;
             matched += 1;
         }
         let err = (sum_got - sum_ref) / sum_ref;
-        eprintln!("{trial}: {matched} clean strides matched, {} detected in all, distance error {:+.2} %", got.len(), err * 100.0);
+        eprintln!(
+            "{trial}: {matched} clean strides matched, {} detected in all, distance error {:+.2} %",
+            got.len(),
+            err * 100.0
+        );
         assert!(matched >= 20);
         assert!(err.abs() < 0.05, "{trial}: distance error {err}");
     }

@@ -71,7 +71,11 @@ fn output_rates_dividers_and_filters() {
         (300, 2, 333_333, 2),
     ] {
         let r = OutputRate::from_hz(hz).unwrap();
-        assert_eq!((r.divider(), r.hz_x1000(), r.dlpf_cfg()), (div, mhz, dlpf), "{hz} Hz");
+        assert_eq!(
+            (r.divider(), r.hz_x1000(), r.dlpf_cfg()),
+            (div, mhz, dlpf),
+            "{hz} Hz"
+        );
     }
     assert!(OutputRate::from_hz(99).is_none());
     assert!(OutputRate::from_hz(1001).is_none());
@@ -79,13 +83,23 @@ fn output_rates_dividers_and_filters() {
 
 #[test]
 fn lsb_constants_per_range() {
-    let a: Vec<u32> = [AccelRange::G2, AccelRange::G4, AccelRange::G8, AccelRange::G16]
-        .map(|r| r.lsb_per_g())
-        .into();
+    let a: Vec<u32> = [
+        AccelRange::G2,
+        AccelRange::G4,
+        AccelRange::G8,
+        AccelRange::G16,
+    ]
+    .map(|r| r.lsb_per_g())
+    .into();
     assert_eq!(a, [16384, 8192, 4096, 2048]);
-    let g: Vec<u32> = [GyroRange::Dps250, GyroRange::Dps500, GyroRange::Dps1000, GyroRange::Dps2000]
-        .map(|r| r.lsb_per_dps_x10())
-        .into();
+    let g: Vec<u32> = [
+        GyroRange::Dps250,
+        GyroRange::Dps500,
+        GyroRange::Dps1000,
+        GyroRange::Dps2000,
+    ]
+    .map(|r| r.lsb_per_dps_x10())
+    .into();
     assert_eq!(g, [1310, 655, 328, 164]);
 }
 
@@ -94,7 +108,10 @@ fn wrong_device_is_reported_and_nothing_is_written() {
     let mut bus = Mock::new(&[T::write_read(ADDR, vec![WHO_AM_I], vec![0x70])]);
     let mut imu = Mpu6050::new(bus.clone(), Address::Ad0Low);
     let e = imu
-        .init(&mut NoopDelay, &Config::new(OutputRate::from_hz(200).unwrap()))
+        .init(
+            &mut NoopDelay,
+            &Config::new(OutputRate::from_hz(200).unwrap()),
+        )
         .unwrap_err();
     assert_eq!(e, Error::WrongDevice(0x70));
     bus.done();
@@ -194,7 +211,10 @@ fn fifo_partial_sample_is_misaligned() {
     ]);
     let mut imu = Mpu6050::new(bus.clone(), Address::Ad0Low);
     let mut out = [RawSample::default(); 4];
-    assert_eq!(imu.read_fifo(&mut out).unwrap_err(), Error::FifoMisaligned(15));
+    assert_eq!(
+        imu.read_fifo(&mut out).unwrap_err(),
+        Error::FifoMisaligned(15)
+    );
     bus.done();
 }
 

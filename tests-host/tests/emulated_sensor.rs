@@ -18,7 +18,11 @@ fn driver_reads_the_trace_through_the_emulated_bus() {
     .unwrap()
     .leak();
     let mut imu = Mpu6050::new(ReplayMpu6050::new(0x68, bytes), Address::Ad0Low);
-    imu.init(&mut NoopDelay, &Config::new(OutputRate::from_hz(200).unwrap())).unwrap();
+    imu.init(
+        &mut NoopDelay,
+        &Config::new(OutputRate::from_hz(200).unwrap()),
+    )
+    .unwrap();
     let mut n = 0;
     loop {
         match imu.read_sample() {
@@ -37,5 +41,8 @@ fn driver_reads_the_trace_through_the_emulated_bus() {
 #[test]
 fn wrong_address_does_not_answer() {
     let mut imu = Mpu6050::new(ReplayMpu6050::new(0x68, &[]), Address::Ad0High);
-    assert_eq!(imu.probe().unwrap_err(), Error::Bus(ReplayBusError::NoDevice));
+    assert_eq!(
+        imu.probe().unwrap_err(),
+        Error::Bus(ReplayBusError::NoDevice)
+    );
 }

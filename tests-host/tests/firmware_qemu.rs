@@ -36,30 +36,62 @@ fn qemu_m4_strides_equal_host_replay() {
         |_| {},
     )
     .expect("qemu runs");
-    assert_eq!(out.status, 0, "firmware exit status; log:\n{}", out.lines.join("\n"));
-    let on_target: Vec<LoggedStride> = out.lines.iter().filter_map(|l| parse_stride_line(l)).collect();
+    assert_eq!(
+        out.status,
+        0,
+        "firmware exit status; log:\n{}",
+        out.lines.join("\n")
+    );
+    let on_target: Vec<LoggedStride> = out
+        .lines
+        .iter()
+        .filter_map(|l| parse_stride_line(l))
+        .collect();
 
-    let bytes = std::fs::read(firmware::repo_root().join(format!("fixtures/{FIRMWARE_TRACE}.mpu6050"))).unwrap();
+    let bytes =
+        std::fs::read(firmware::repo_root().join(format!("fixtures/{FIRMWARE_TRACE}.mpu6050")))
+            .unwrap();
     let counts: Vec<RawSample> = bytes
         .chunks_exact(14)
         .map(|c| RawSample::from_be_bytes(c.try_into().unwrap()))
         .collect();
-    let host: Vec<LoggedStride> = replay_counts(&counts, SampleRate::from_hz(200).unwrap(), Ranges::default(), |i| i as f64)
-        .iter()
-        .map(|s| LoggedStride {
-            index: s.raw.index,
-            idx: [s.raw.start, s.raw.heel_off, s.raw.toe_off, s.raw.heel_strike, s.raw.end],
-            length_mm: s.raw.length_mm,
-            climb_mm: s.raw.climb_mm,
-            flags: s.raw.flags.0,
-        })
-        .collect();
+    let host: Vec<LoggedStride> = replay_counts(
+        &counts,
+        SampleRate::from_hz(200).unwrap(),
+        Ranges::default(),
+        |i| i as f64,
+    )
+    .iter()
+    .map(|s| LoggedStride {
+        index: s.raw.index,
+        idx: [
+            s.raw.start,
+            s.raw.heel_off,
+            s.raw.toe_off,
+            s.raw.heel_strike,
+            s.raw.end,
+        ],
+        length_mm: s.raw.length_mm,
+        climb_mm: s.raw.climb_mm,
+        flags: s.raw.flags.0,
+    })
+    .collect();
     assert!(host.len() >= 20, "host found {} strides", host.len());
     assert_eq!(on_target, host);
 
-    let summary = out.lines.iter().find(|l| l.starts_with("summary")).expect("summary line");
-    assert!(summary.contains(&format!("strides={}", host.len())), "{summary}");
-    assert!(summary.contains(&format!("samples={}", counts.len())), "{summary}");
+    let summary = out
+        .lines
+        .iter()
+        .find(|l| l.starts_with("summary"))
+        .expect("summary line");
+    assert!(
+        summary.contains(&format!("strides={}", host.len())),
+        "{summary}"
+    );
+    assert!(
+        summary.contains(&format!("samples={}", counts.len())),
+        "{summary}"
+    );
     assert!(summary.contains("overruns=0"), "{summary}");
     assert!(summary.contains("bus_errors=0"), "{summary}");
 }

@@ -28,7 +28,10 @@ fn mul_q30_within_half_lsb() {
     let mut r = rng();
     let mut max = 0f64;
     for _ in 0..100_000 {
-        let (a, b) = (r.random_range(-Q30_ONE..=Q30_ONE), r.random_range(-Q30_ONE..=Q30_ONE));
+        let (a, b) = (
+            r.random_range(-Q30_ONE..=Q30_ONE),
+            r.random_range(-Q30_ONE..=Q30_ONE),
+        );
         let err = (f(mul_q30(a, b)) - f(a) * f(b)).abs();
         max = max.max(err);
     }
@@ -52,9 +55,21 @@ fn quat_f64(q: QuatQ30) -> [f64; 4] {
 fn rotate_f64(q: [f64; 4], v: [f64; 3]) -> [f64; 3] {
     let [w, x, y, z] = q;
     let m = [
-        [1.0 - 2.0 * (y * y + z * z), 2.0 * (x * y - w * z), 2.0 * (x * z + w * y)],
-        [2.0 * (x * y + w * z), 1.0 - 2.0 * (x * x + z * z), 2.0 * (y * z - w * x)],
-        [2.0 * (x * z - w * y), 2.0 * (y * z + w * x), 1.0 - 2.0 * (x * x + y * y)],
+        [
+            1.0 - 2.0 * (y * y + z * z),
+            2.0 * (x * y - w * z),
+            2.0 * (x * z + w * y),
+        ],
+        [
+            2.0 * (x * y + w * z),
+            1.0 - 2.0 * (x * x + z * z),
+            2.0 * (y * z - w * x),
+        ],
+        [
+            2.0 * (x * z - w * y),
+            2.0 * (y * z + w * x),
+            1.0 - 2.0 * (x * x + y * y),
+        ],
     ];
     [0, 1, 2].map(|i| (0..3).map(|k| m[i][k] * v[k]).sum())
 }
@@ -65,9 +80,17 @@ fn matrix_matches_f64_within_2_lsb() {
     for _ in 0..10_000 {
         let c: [f64; 4] = [0; 4].map(|_| r.random_range(-1.0..1.0));
         let n = c.iter().map(|v| v * v).sum::<f64>().sqrt();
-        let qq = QuatQ30 { w: q(c[0] / n), x: q(c[1] / n), y: q(c[2] / n), z: q(c[3] / n) };
+        let qq = QuatQ30 {
+            w: q(c[0] / n),
+            x: q(c[1] / n),
+            y: q(c[2] / n),
+            z: q(c[3] / n),
+        };
         let m = qq.matrix();
-        for (j, e) in [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]].iter().enumerate() {
+        for (j, e) in [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]]
+            .iter()
+            .enumerate()
+        {
             let col = rotate_f64(quat_f64(qq), *e);
             for i in 0..3 {
                 assert!((f(m[i][j]) - col[i]).abs() <= 2.0 * LSB, "{:?}", qq);
@@ -83,7 +106,12 @@ fn hamilton_product_within_2_lsb() {
         let mk = |r: &mut ChaCha8Rng| {
             let c: [f64; 4] = [0; 4].map(|_| r.random_range(-1.0..1.0));
             let n = c.iter().map(|v| v * v).sum::<f64>().sqrt();
-            QuatQ30 { w: q(c[0] / n), x: q(c[1] / n), y: q(c[2] / n), z: q(c[3] / n) }
+            QuatQ30 {
+                w: q(c[0] / n),
+                x: q(c[1] / n),
+                y: q(c[2] / n),
+                z: q(c[3] / n),
+            }
         };
         let (a, b) = (mk(&mut r), mk(&mut r));
         let [aw, ax, ay, az] = quat_f64(a);
@@ -94,7 +122,7 @@ fn hamilton_product_within_2_lsb() {
             aw * by - ax * bz + ay * bw + az * bx,
             aw * bz + ax * by - ay * bx + az * bw,
         ];
-        let got = quat_f64(a.mul(b));
+        let got = quat_f64(a * b);
         for k in 0..4 {
             assert!((got[k] - exact[k]).abs() <= 2.0 * LSB);
         }
@@ -112,19 +140,27 @@ fn quaternion_integration_tracks_exact_rotation() {
         let n = a.iter().map(|v| v * v).sum::<f64>().sqrt();
         let axis = a.map(|v| v / n);
         for (rate, hz, steps, bound) in [(5.0, 200.0, 200, 2e-6), (34.9, 100.0, 10, 5e-4)] {
-        let h = axis.map(|v| q(v * rate / hz / 2.0));
-        let mut att = QuatQ30::IDENTITY;
-        for _ in 0..steps {
-            att = att.integrate_half_angle(h);
-        }
-        let got = quat_f64(att);
-        let norm = got.iter().map(|v| v * v).sum::<f64>().sqrt();
-        assert!((norm - 1.0).abs() < 1e-8, "norm {norm}");
-        let half = rate * steps as f64 / hz / 2.0;
-        let exact = [half.cos(), axis[0] * half.sin(), axis[1] * half.sin(), axis[2] * half.sin()];
-        let dot: f64 = got.iter().zip(exact).map(|(a, b)| a * b).sum::<f64>() / norm;
-        let angle = 2.0 * dot.abs().min(1.0).acos();
-        assert!(angle < bound, "angle error {angle:e} rad at {rate} rad/s, {hz} Hz");
+            let h = axis.map(|v| q(v * rate / hz / 2.0));
+            let mut att = QuatQ30::IDENTITY;
+            for _ in 0..steps {
+                att = att.integrate_half_angle(h);
+            }
+            let got = quat_f64(att);
+            let norm = got.iter().map(|v| v * v).sum::<f64>().sqrt();
+            assert!((norm - 1.0).abs() < 1e-8, "norm {norm}");
+            let half = rate * steps as f64 / hz / 2.0;
+            let exact = [
+                half.cos(),
+                axis[0] * half.sin(),
+                axis[1] * half.sin(),
+                axis[2] * half.sin(),
+            ];
+            let dot: f64 = got.iter().zip(exact).map(|(a, b)| a * b).sum::<f64>() / norm;
+            let angle = 2.0 * dot.abs().min(1.0).acos();
+            assert!(
+                angle < bound,
+                "angle error {angle:e} rad at {rate} rad/s, {hz} Hz"
+            );
         }
     }
 }
@@ -132,7 +168,13 @@ fn quaternion_integration_tracks_exact_rotation() {
 #[test]
 fn level_from_up_takes_gravity_to_plus_z_any_mounting() {
     let mut r = rng();
-    let mut cases: Vec<[i64; 3]> = vec![[0, 0, 2048], [0, 0, -2048], [2048, 0, 0], [0, -5, -2048], [1, 1, -2048]];
+    let mut cases: Vec<[i64; 3]> = vec![
+        [0, 0, 2048],
+        [0, 0, -2048],
+        [2048, 0, 0],
+        [0, -5, -2048],
+        [1, 1, -2048],
+    ];
     for _ in 0..10_000 {
         cases.push([0; 3].map(|_| r.random_range(-(1i64 << 23)..(1i64 << 23))));
     }
@@ -143,7 +185,10 @@ fn level_from_up_takes_gravity_to_plus_z_any_mounting() {
             continue; // integer direction too coarse to judge
         }
         let v = rotate_f64(quat_f64(qq), up.map(|v| v as f64 / n));
-        assert!(v[0].abs() < 1e-7 && v[1].abs() < 1e-7 && (v[2] - 1.0).abs() < 1e-7, "{up:?} → {v:?}");
+        assert!(
+            v[0].abs() < 1e-7 && v[1].abs() < 1e-7 && (v[2] - 1.0).abs() < 1e-7,
+            "{up:?} → {v:?}"
+        );
         // Never a rotation about the vertical beyond what leveling needs: yaw of x stays put
         // up to the tilt (checked loosely by unit norm).
         let norm: f64 = quat_f64(qq).iter().map(|c| c * c).sum();
@@ -181,7 +226,10 @@ fn sample_rate_conversions() {
 
 #[test]
 fn stance_thresholds_match_physical_units_within_one_count() {
-    for (accel, gyro) in [(AccelRange::G16, GyroRange::Dps2000), (AccelRange::G2, GyroRange::Dps250)] {
+    for (accel, gyro) in [
+        (AccelRange::G16, GyroRange::Dps2000),
+        (AccelRange::G2, GyroRange::Dps250),
+    ] {
         let t = StanceThresholds::new(SampleRate::from_hz(200).unwrap(), accel, gyro);
         let a = ACCEL_STD_MAX_MMPS2 as f64 / 1000.0 * accel.lsb_per_g() as f64 / 9.80665;
         let g = GYRO_RMS_MAX_MRADPS as f64 / 1000.0 * 180.0 / std::f64::consts::PI
@@ -272,8 +320,16 @@ fn zupt_displacement_matches_f64_reference_within_1mm() {
         movement.iter().for_each(|s| z.process(s));
         let d = z.displacement();
         let (h, v) = zupt_f64(stance, movement, 200.0);
-        assert!((d.horizontal_um as f64 * 1e-6 - h).abs() < 1e-3, "{} vs {h}", d.horizontal_um);
-        assert!((d.vertical_um as f64 * 1e-6 - v).abs() < 1e-3, "{} vs {v}", d.vertical_um);
+        assert!(
+            (d.horizontal_um as f64 * 1e-6 - h).abs() < 1e-3,
+            "{} vs {h}",
+            d.horizontal_um
+        );
+        assert!(
+            (d.vertical_um as f64 * 1e-6 - v).abs() < 1e-3,
+            "{} vs {v}",
+            d.vertical_um
+        );
         checked += 1;
     }
     assert!(checked >= 20);

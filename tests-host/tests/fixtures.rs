@@ -5,11 +5,11 @@ use std::path::PathBuf;
 
 use gaitclip::rate::SampleRate;
 use gaitclip::sample::RawSample;
+use gaitclip_host::csv_trace;
 use gaitclip_host::fixtures::{self, FIRMWARE_TRACE};
 use gaitclip_host::replay::{replay, replay_counts};
 use gaitclip_host::sim;
 use gaitclip_host::trace::Ranges;
-use gaitclip_host::csv_trace;
 
 fn dir() -> PathBuf {
     PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../fixtures")
@@ -21,8 +21,9 @@ fn committed_fixtures_are_not_stale() {
     fixtures::write_all(&tmp).unwrap();
     for name in fixtures::file_names() {
         let fresh = std::fs::read(tmp.join(&name)).unwrap();
-        let committed = std::fs::read(dir().join(&name))
-            .unwrap_or_else(|e| panic!("fixtures/{name}: {e}; regenerate with `cargo run --release -- simulate`"));
+        let committed = std::fs::read(dir().join(&name)).unwrap_or_else(|e| {
+            panic!("fixtures/{name}: {e}; regenerate with `cargo run --release -- simulate`")
+        });
         assert!(
             fresh == committed,
             "fixtures/{name} is stale: regenerate with `cd tests-host && cargo run --release -- simulate`"
@@ -35,7 +36,10 @@ fn committed_fixtures_are_not_stale() {
 fn csv_and_register_dump_hold_the_same_counts() {
     let trace = csv_trace::read(&dir().join(format!("{FIRMWARE_TRACE}.csv")), None).unwrap();
     let bytes = std::fs::read(dir().join(format!("{FIRMWARE_TRACE}.mpu6050"))).unwrap();
-    let counts: Vec<RawSample> = bytes.chunks_exact(14).map(|c| RawSample::from_be_bytes(c.try_into().unwrap())).collect();
+    let counts: Vec<RawSample> = bytes
+        .chunks_exact(14)
+        .map(|c| RawSample::from_be_bytes(c.try_into().unwrap()))
+        .collect();
     assert_eq!(trace.samples.len(), counts.len());
     let r = Ranges::default();
     for (s, c) in trace.samples.iter().zip(&counts) {
@@ -43,7 +47,9 @@ fn csv_and_register_dump_hold_the_same_counts() {
     }
     // And the replay of either gives the same strides.
     let a = replay(&trace, r).unwrap();
-    let b = replay_counts(&counts, SampleRate::from_hz(200).unwrap(), r, |i| trace.samples[i as usize].t_s);
+    let b = replay_counts(&counts, SampleRate::from_hz(200).unwrap(), r, |i| {
+        trace.samples[i as usize].t_s
+    });
     assert_eq!(a, b);
 }
 
@@ -62,13 +68,50 @@ fn replay_finds_simulated_strides() {
         for (g, w) in got.iter().zip(&truth) {
             let ctx = format!("{} stride {}", sc.name, w.stride);
             let k = if w.flag.is_empty() { 1.0 } else { 3.0 };
-            let len_tol = if w.flag.is_empty() { 0.03 * w.length_m + 0.02 } else { 0.05 };
-            assert!((g.heel_off_s - t(w.heel_off_idx)).abs() <= 0.04 * k, "{ctx}: heel-off {} vs {}", g.heel_off_s, t(w.heel_off_idx));
-            assert!((g.foot_flat_s - t(w.end_idx)).abs() <= 0.04 * k, "{ctx}: foot-flat {} vs {}", g.foot_flat_s, t(w.end_idx));
-            assert!((g.toe_off_s - t(w.toe_off_idx)).abs() <= 0.06 * k, "{ctx}: toe-off {} vs {}", g.toe_off_s, t(w.toe_off_idx));
-            assert!((g.heel_strike_s - t(w.heel_strike_idx)).abs() <= 0.06 * k, "{ctx}: heel-strike {} vs {}", g.heel_strike_s, t(w.heel_strike_idx));
-            assert!((g.length_m - w.length_m).abs() <= len_tol, "{ctx}: length {} vs {}", g.length_m, w.length_m);
+            let len_tol = if w.flag.is_empty() {
+                0.03 * w.length_m + 0.02
+            } else {
+                0.05
+            };
+            assert!(
+                (g.heel_off_s - t(w.heel_off_idx)).abs() <= 0.04 * k,
+                "{ctx}: heel-off {} vs {}",
+                g.heel_off_s,
+                t(w.heel_off_idx)
+            );
+            assert!(
+                (g.foot_flat_s - t(w.end_idx)).abs() <= 0.04 * k,
+                "{ctx}: foot-flat {} vs {}",
+                g.foot_flat_s,
+                t(w.end_idx)
+            );
+            assert!(
+                (g.toe_off_s - t(w.toe_off_idx)).abs() <= 0.06 * k,
+                "{ctx}: toe-off {} vs {}",
+                g.toe_off_s,
+                t(w.toe_off_idx)
+            );
+            assert!(
+                (g.heel_strike_s - t(w.heel_strike_idx)).abs() <= 0.06 * k,
+                "{ctx}: heel-strike {} vs {}",
+                g.heel_strike_s,
+                t(w.heel_strike_idx)
+            );
+            assert!(
+                (g.length_m - w.length_m).abs() <= len_tol,
+                "{ctx}: length {} vs {}",
+                g.length_m,
+                w.length_m
+            );
             assert!(g.valid, "{ctx}: flagged {:?}", g.flags);
         }
     }
+}
+
+/// The pipeline's whole state is a compile-time size (it lives on the firmware's stack).
+#[test]
+fn pipeline_state_is_bounded() {
+    let bytes = std::mem::size_of::<gaitclip::pipeline::Pipeline>();
+    eprintln!("Pipeline state: {bytes} bytes");
+    assert!(bytes < 16 * 1024, "{bytes}");
 }

@@ -5,10 +5,10 @@ use std::collections::BTreeMap;
 use std::io::Cursor;
 use std::path::PathBuf;
 
+use gaitclip_host::csv_trace;
 use gaitclip_host::mcap_io::{self, encode_ros2_imu, McapError, ROS2_IMU_SCHEMA};
 use gaitclip_host::replay::replay;
 use gaitclip_host::trace::Ranges;
-use gaitclip_host::csv_trace;
 
 fn demo() -> gaitclip_host::trace::Trace {
     let p = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../fixtures/demo_walk.csv");
@@ -24,7 +24,12 @@ fn written_mcap_replays_to_the_same_strides() {
     let trace = demo();
     let strides = replay(&trace, Ranges::default()).unwrap();
     let path = tmp("roundtrip.mcap");
-    mcap_io::write(std::fs::File::create(&path).unwrap(), &trace.samples, &strides).unwrap();
+    mcap_io::write(
+        std::fs::File::create(&path).unwrap(),
+        &trace.samples,
+        &strides,
+    )
+    .unwrap();
     let back = mcap_io::read(&path, None).unwrap();
     assert_eq!(back.samples, trace.samples);
     assert!((back.rate_hz - 200.0).abs() < 1e-6);
@@ -45,8 +50,12 @@ fn ros2_imu_cdr_is_read() {
     let path = tmp("ros2.mcap");
     {
         let mut w = mcap::Writer::new(Cursor::new(Vec::new())).unwrap();
-        let schema = w.add_schema(ROS2_IMU_SCHEMA, "ros2msg", b"# sensor_msgs/msg/Imu").unwrap();
-        let ch = w.add_channel(schema, "/imu/data", "cdr", &BTreeMap::new()).unwrap();
+        let schema = w
+            .add_schema(ROS2_IMU_SCHEMA, "ros2msg", b"# sensor_msgs/msg/Imu")
+            .unwrap();
+        let ch = w
+            .add_channel(schema, "/imu/data", "cdr", &BTreeMap::new())
+            .unwrap();
         for (i, s) in trace.samples.iter().enumerate() {
             let data = encode_ros2_imu(s, "left_foot");
             let h = mcap::records::MessageHeader {
@@ -94,7 +103,9 @@ fn big_endian_cdr_decodes_too() {
     let d = mcap_io::decode_ros2_imu(&be).unwrap();
     assert_eq!(d.acc_mps2, s.acc_mps2);
     assert_eq!(d.gyr_radps, s.gyr_radps);
-    assert!(mcap_io::decode_ros2_imu(&be[..40]).unwrap_err().contains("truncated"));
+    assert!(mcap_io::decode_ros2_imu(&be[..40])
+        .unwrap_err()
+        .contains("truncated"));
 }
 
 #[test]
@@ -103,8 +114,15 @@ fn mcap_without_imu_lists_the_channels_it_saw() {
     {
         let mut w = mcap::Writer::new(Cursor::new(Vec::new())).unwrap();
         let schema = w.add_schema("foo.Bar", "jsonschema", b"{}").unwrap();
-        let ch = w.add_channel(schema, "/gps", "json", &BTreeMap::new()).unwrap();
-        let h = mcap::records::MessageHeader { channel_id: ch, sequence: 0, log_time: 0, publish_time: 0 };
+        let ch = w
+            .add_channel(schema, "/gps", "json", &BTreeMap::new())
+            .unwrap();
+        let h = mcap::records::MessageHeader {
+            channel_id: ch,
+            sequence: 0,
+            log_time: 0,
+            publish_time: 0,
+        };
         w.write_to_known_channel(&h, b"{}").unwrap();
         w.finish().unwrap();
         std::fs::write(&path, w.into_inner().into_inner()).unwrap();

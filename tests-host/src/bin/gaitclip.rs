@@ -8,7 +8,11 @@ use gaitclip_host::trace::{Ranges, Trace};
 use gaitclip_host::{csv_trace, fixtures, mcap_io, replay};
 
 #[derive(Parser)]
-#[command(name = "gaitclip", version, about = "Replay IMU traces through the gaitclip firmware core")]
+#[command(
+    name = "gaitclip",
+    version,
+    about = "Replay IMU traces through the gaitclip firmware core"
+)]
 struct Cli {
     #[command(subcommand)]
     cmd: Cmd,

@@ -1,0 +1,31 @@
+#!/usr/bin/env bash
+# Runs every check of gaitclip, as CI does: formatting and clippy (-D warnings) in both
+# workspaces, firmware builds for both Cortex-M targets, and the host test suite (driver
+# transactions, fixed point vs f64, fixtures, MCAP/CSV readers, real datasets when
+# ../shared/datasets is present, and the bit-exact QEMU run of the firmware).
+# Installs what a fresh Debian machine lacks: qemu-system-arm (apt). rustup installs the
+# toolchain, targets and components named in rust-toolchain.toml by itself.
+set -euo pipefail
+root=$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)
+cd "$root"
+
+if ! command -v qemu-system-arm >/dev/null 2>&1; then
+  echo "== installing qemu-system-arm (Debian)"
+  sudo_cmd=""
+  [ "$(id -u)" -eq 0 ] || sudo_cmd="sudo"
+  $sudo_cmd apt-get update -qq
+  $sudo_cmd apt-get install -y -qq qemu-system-arm
+fi
+
+echo "== firmware crate: rustfmt, clippy, builds (thumbv7em-none-eabihf, thumbv6m-none-eabi)"
+cargo fmt --check
+cargo clippy --release -- -D warnings
+cargo clippy --release --lib --target thumbv6m-none-eabi -- -D warnings
+cargo build --release
+cargo build --release --lib --target thumbv6m-none-eabi
+
+echo "== tests-host: rustfmt, clippy, tests"
+cd "$root/tests-host"
+cargo fmt --check
+cargo clippy --all-targets -- -D warnings
+cargo test
