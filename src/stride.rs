@@ -226,13 +226,16 @@ impl StrideTracker {
                 )
                 .0 as u32
         };
-        let toe_off = self.heel_off + argmax(&self.magnitude[..half]);
-        let heel_strike = self.heel_off + half as u32 + argmax(&self.magnitude[half..]);
-        let stance = self.heel_off - self.stance_start;
+        let toe_off = self.heel_off.wrapping_add(argmax(&self.magnitude[..half]));
+        let heel_strike = self
+            .heel_off
+            .wrapping_add(half as u32)
+            .wrapping_add(argmax(&self.magnitude[half..]));
+        let stance = self.heel_off.wrapping_sub(self.stance_start);
         let mut flags = self.flags;
         let start = if stance > self.max_stance {
             flags |= StrideFlags::FROM_REST;
-            self.heel_off - self.max_stance
+            self.heel_off.wrapping_sub(self.max_stance)
         } else {
             self.stance_start
         };

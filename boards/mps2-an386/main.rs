@@ -4,7 +4,9 @@
 //! MPU6050 through the real driver (the sensor itself is emulated at the bus by
 //! [`replay_mpu6050`], replaying a trace from flash) and pushes it into an SPSC queue. The
 //! main loop drains the queue through the pipeline, logs one defmt line per stride and sleeps
-//! with `wfi` when the queue is empty. When the trace ends it logs a summary and exits QEMU
+//! with `wfi` when the queue is empty. A sample that finds the queue full, or a sensor that does
+//! not answer after retries and a re-initialisation, is counted and reported to the pipeline
+//! as a gap, never dropped silently. When the trace ends it logs a summary and exits QEMU
 //! through semihosting with status 0; a panic or HardFault exits with status 1.
 
 #![no_std]
@@ -40,15 +42,25 @@ use stride_log::StrideLog;
 /// Samples the queue holds between the interrupt and the main loop: 64 = 320 ms at 200 Hz,
 /// far more than one stride's processing takes.
 const QUEUE_LEN: usize = 64;
-/// Consecutive bus errors after which the sensor is re-initialised.
+/// Bus errors in a row (one read and its retries) after which the sensor is re-initialised.
 const REINIT_AFTER_ERRORS: u32 = 3;
 
 type Imu = Mpu6050<ReplayMpu6050>;
 
-static PRODUCER: Mutex<RefCell<Option<Producer<'static, RawSample>>>> =
-    Mutex::new(RefCell::new(None));
-static IMU: Mutex<RefCell<Option<Imu>>> = Mutex::new(RefCell::new(None));
+/// What the sample interrupt hands to the main loop.
+#[derive(Clone, Copy)]
+enum Item {
+    Sample(RawSample),
+    /// This many sample periods were lost (queue full, sensor not answering): the pipeline
+    /// drops the stride in progress instead of measuring across the hole.
+    Gap(u32),
+}
+
+static PRODUCER: Mutex<RefCell<Option<Producer<'static, Item>>>> = Mutex::new(RefCell::new(None));
+static IMU: Mutex<RefCell<Option<(Imu, mpu6050::Config)>>> = Mutex::new(RefCell::new(None));
 static OVERRUNS: AtomicU32 = AtomicU32::new(0);
+/// Sample periods lost and not yet reported to the main loop.
+static PENDING_GAP: AtomicU32 = AtomicU32::new(0);
 static BUS_ERRORS: AtomicU32 = AtomicU32::new(0);
 static TRACE_DONE: AtomicBool = AtomicBool::new(false);
 
@@ -109,13 +121,13 @@ fn main() -> ! {
         trace::RATE_MILLIHERTZ
     );
 
-    let Some(queue) = cortex_m::singleton!(: Queue<RawSample, QUEUE_LEN> = Queue::new()) else {
+    let Some(queue) = cortex_m::singleton!(: Queue<Item, QUEUE_LEN> = Queue::new()) else {
         fail();
     };
     let (producer, mut consumer) = queue.split();
     irq::free(|cs| {
         PRODUCER.borrow(cs).replace(Some(producer));
-        IMU.borrow(cs).replace(Some(imu));
+        IMU.borrow(cs).replace(Some((imu, sensor_config)));
     });
 
     // Note(unsafe): TIMER0 is driven only through this value, from here and its handler.
@@ -129,10 +141,21 @@ fn main() -> ! {
     let mut log = StrideLog::new(rate);
     let mut samples = 0u32;
     loop {
-        while let Some(s) = consumer.dequeue() {
-            samples = samples.wrapping_add(1);
-            if let Some(stride) = pipeline.process(&s) {
-                log.stride(&stride);
+        while let Some(item) = consumer.dequeue() {
+            match item {
+                Item::Sample(s) => {
+                    samples = samples.wrapping_add(1);
+                    if let Some(stride) = pipeline.process(&s) {
+                        log.stride(&stride);
+                    }
+                }
+                Item::Gap(n) => {
+                    defmt::warn!(
+                        "gap of {=u32} samples: the stride in progress is dropped",
+                        n
+                    );
+                    pipeline.gap(n);
+                }
             }
         }
         if TRACE_DONE.load(Ordering::Acquire) && !consumer.ready() {
@@ -168,31 +191,47 @@ fn on_timer_tick() {
     irq::free(|cs| {
         let mut imu = IMU.borrow(cs).borrow_mut();
         let mut producer = PRODUCER.borrow(cs).borrow_mut();
-        let (Some(imu), Some(producer)) = (imu.as_mut(), producer.as_mut()) else {
+        let (Some((imu, config)), Some(producer)) = (imu.as_mut(), producer.as_mut()) else {
             return;
         };
         let mut failures = 0;
-        let sample = loop {
+        let item = loop {
             match imu.read_sample() {
-                Ok(s) => break s,
+                Ok(s) => break Item::Sample(s),
                 Err(mpu6050::Error::Bus(ReplayBusError::Exhausted)) => {
                     TRACE_DONE.store(true, Ordering::Release);
                     timer.stop();
                     return;
                 }
                 Err(_) => {
-                    // Counted and retried; after repeated failures the sensor is set up
-                    // again and the sample is given up (the pipeline sees a gap).
+                    // Counted and retried; after repeated failures the sensor is set up again
+                    // and this sample period becomes a gap.
                     BUS_ERRORS.fetch_add(1, Ordering::Relaxed);
                     failures += 1;
                     if failures >= REINIT_AFTER_ERRORS {
+                        if imu.init(&mut SpinDelay, config).is_err() {
+                            BUS_ERRORS.fetch_add(1, Ordering::Relaxed);
+                        }
+                        PENDING_GAP.fetch_add(1, Ordering::Relaxed);
                         return;
                     }
                 }
             }
         };
-        if producer.enqueue(sample).is_err() {
+        // Report lost periods before the sample that follows them; if the queue has no room
+        // for both, this sample is lost too and joins the gap.
+        let gap = PENDING_GAP.load(Ordering::Relaxed);
+        if gap > 0 {
+            if producer.enqueue(Item::Gap(gap)).is_err() {
+                OVERRUNS.fetch_add(1, Ordering::Relaxed);
+                PENDING_GAP.fetch_add(1, Ordering::Relaxed);
+                return;
+            }
+            PENDING_GAP.store(0, Ordering::Relaxed);
+        }
+        if producer.enqueue(item).is_err() {
             OVERRUNS.fetch_add(1, Ordering::Relaxed);
+            PENDING_GAP.fetch_add(1, Ordering::Relaxed);
         }
     });
 }
