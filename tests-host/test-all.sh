@@ -28,4 +28,9 @@ echo "== tests-host: rustfmt, clippy, tests"
 cd "$root/tests-host"
 cargo fmt --check
 cargo clippy --all-targets -- -D warnings
-cargo test
+log=$(mktemp)
+cargo test 2>&1 | tee "$log"
+# One closing line over every test binary.
+awk '/^test result:/ { for (i = 1; i <= NF; i++) { if ($(i) ~ /^passed/) p += $(i-1); if ($(i) ~ /^failed/) f += $(i-1) } }
+     END { printf "tests: %d passed, %d failed\n", p, f }' "$log"
+rm -f "$log"
