@@ -35,9 +35,6 @@ impl<const N: usize> MeanFilter<N> {
         }
     }
 
-    /// Group delay of the filter in samples, times two ((N − 1) / 2 samples).
-    pub const DELAY_X2: usize = N - 1;
-
     /// Pushes `x` and returns the mean of the window.
     pub fn process(&mut self, x: [i16; 3]) -> [i16; 3] {
         let slot = self.head & (N - 1);

@@ -48,6 +48,18 @@ fn isqrt_is_exact() {
     }
 }
 
+/// A uniformly random unit quaternion in Q30.
+fn random_unit(r: &mut ChaCha8Rng) -> QuatQ30 {
+    let c: [f64; 4] = [0; 4].map(|_| r.random_range(-1.0..1.0));
+    let n = c.iter().map(|v| v * v).sum::<f64>().sqrt();
+    QuatQ30 {
+        w: q(c[0] / n),
+        x: q(c[1] / n),
+        y: q(c[2] / n),
+        z: q(c[3] / n),
+    }
+}
+
 fn quat_f64(q: QuatQ30) -> [f64; 4] {
     [f(q.w), f(q.x), f(q.y), f(q.z)]
 }
