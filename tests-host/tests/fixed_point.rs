@@ -90,14 +90,7 @@ fn rotate_f64(q: [f64; 4], v: [f64; 3]) -> [f64; 3] {
 fn matrix_matches_f64_within_2_lsb() {
     let mut r = rng();
     for _ in 0..10_000 {
-        let c: [f64; 4] = [0; 4].map(|_| r.random_range(-1.0..1.0));
-        let n = c.iter().map(|v| v * v).sum::<f64>().sqrt();
-        let qq = QuatQ30 {
-            w: q(c[0] / n),
-            x: q(c[1] / n),
-            y: q(c[2] / n),
-            z: q(c[3] / n),
-        };
+        let qq = random_unit(&mut r);
         let m = qq.matrix();
         for (j, e) in [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]]
             .iter()
@@ -115,17 +108,7 @@ fn matrix_matches_f64_within_2_lsb() {
 fn hamilton_product_within_2_lsb() {
     let mut r = rng();
     for _ in 0..10_000 {
-        let mk = |r: &mut ChaCha8Rng| {
-            let c: [f64; 4] = [0; 4].map(|_| r.random_range(-1.0..1.0));
-            let n = c.iter().map(|v| v * v).sum::<f64>().sqrt();
-            QuatQ30 {
-                w: q(c[0] / n),
-                x: q(c[1] / n),
-                y: q(c[2] / n),
-                z: q(c[3] / n),
-            }
-        };
-        let (a, b) = (mk(&mut r), mk(&mut r));
+        let (a, b) = (random_unit(&mut r), random_unit(&mut r));
         let [aw, ax, ay, az] = quat_f64(a);
         let [bw, bx, by, bz] = quat_f64(b);
         let exact = [
