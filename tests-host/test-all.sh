@@ -9,13 +9,7 @@ set -euo pipefail
 root=$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)
 cd "$root"
 
-if ! command -v qemu-system-arm >/dev/null 2>&1; then
-  echo "== installing qemu-system-arm (Debian)"
-  sudo_cmd=""
-  [ "$(id -u)" -eq 0 ] || sudo_cmd="sudo"
-  $sudo_cmd apt-get update -qq
-  $sudo_cmd apt-get install -y -qq qemu-system-arm
-fi
+bash "$root/boards/install-qemu"
 
 echo "== firmware crate: rustfmt, clippy, builds (thumbv7em-none-eabihf, thumbv6m-none-eabi)"
 cargo fmt --check

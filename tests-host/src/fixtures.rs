@@ -13,6 +13,19 @@ use crate::trace::Ranges;
 /// The scenario the emulated board replays from flash.
 pub const FIRMWARE_TRACE: &str = "demo_walk";
 
+/// The committed register dump the emulated board replays, decoded to counts.
+pub fn firmware_trace_counts() -> std::io::Result<Vec<gaitclip::sample::RawSample>> {
+    let path = Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("../fixtures")
+        .join(format!("{FIRMWARE_TRACE}.mpu6050"));
+    let bytes = fs::read(path)?;
+    Ok(bytes
+        .chunks_exact(gaitclip::sample::SAMPLE_BYTES)
+        .filter_map(|c| c.try_into().ok())
+        .map(|c| gaitclip::sample::RawSample::from_be_bytes(&c))
+        .collect())
+}
+
 /// Every file [`write_all`] writes, for the staleness test.
 pub fn file_names() -> Vec<String> {
     let mut v = Vec::new();

@@ -3,9 +3,7 @@
 //! same per-stride integers as the host replay of the same fixture.
 
 use gaitclip::rate::SampleRate;
-use gaitclip::sample::RawSample;
 use gaitclip_host::firmware::{self, parse_stride_line, LoggedStride};
-use gaitclip_host::fixtures::FIRMWARE_TRACE;
 use gaitclip_host::qemu::{self, RunOptions};
 use gaitclip_host::replay::replay_counts;
 use gaitclip_host::trace::Ranges;
@@ -48,13 +46,7 @@ fn qemu_m4_strides_equal_host_replay() {
         .filter_map(|l| parse_stride_line(l))
         .collect();
 
-    let bytes =
-        std::fs::read(firmware::repo_root().join(format!("fixtures/{FIRMWARE_TRACE}.mpu6050")))
-            .unwrap();
-    let counts: Vec<RawSample> = bytes
-        .chunks_exact(14)
-        .map(|c| RawSample::from_be_bytes(c.try_into().unwrap()))
-        .collect();
+    let counts = gaitclip_host::fixtures::firmware_trace_counts().unwrap();
     let host: Vec<LoggedStride> = replay_counts(
         &counts,
         SampleRate::from_hz(200).unwrap(),

@@ -293,11 +293,7 @@ fn zupt_f64(stance: &[RawSample], movement: &[RawSample], rate_hz: f64) -> (f64,
 #[test]
 fn zupt_displacement_matches_f64_reference_within_1mm() {
     let dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../fixtures");
-    let bytes = std::fs::read(dir.join(format!("{FIRMWARE_TRACE}.mpu6050"))).unwrap();
-    let counts: Vec<RawSample> = bytes
-        .chunks_exact(14)
-        .map(|c| RawSample::from_be_bytes(c.try_into().unwrap()))
-        .collect();
+    let counts = gaitclip_host::fixtures::firmware_trace_counts().unwrap();
     let truth = std::fs::read_to_string(dir.join(format!("{FIRMWARE_TRACE}.truth.csv"))).unwrap();
     let rate = SampleRate::from_hz(200).unwrap();
     let mut checked = 0;

@@ -4,7 +4,6 @@
 use std::path::PathBuf;
 
 use gaitclip::rate::SampleRate;
-use gaitclip::sample::RawSample;
 use gaitclip_host::csv_trace;
 use gaitclip_host::fixtures::{self, FIRMWARE_TRACE};
 use gaitclip_host::replay::{replay, replay_counts};
@@ -35,11 +34,7 @@ fn committed_fixtures_are_not_stale() {
 #[test]
 fn csv_and_register_dump_hold_the_same_counts() {
     let trace = csv_trace::read(&dir().join(format!("{FIRMWARE_TRACE}.csv")), None).unwrap();
-    let bytes = std::fs::read(dir().join(format!("{FIRMWARE_TRACE}.mpu6050"))).unwrap();
-    let counts: Vec<RawSample> = bytes
-        .chunks_exact(14)
-        .map(|c| RawSample::from_be_bytes(c.try_into().unwrap()))
-        .collect();
+    let counts = gaitclip_host::fixtures::firmware_trace_counts().unwrap();
     assert_eq!(trace.samples.len(), counts.len());
     let r = Ranges::default();
     for (s, c) in trace.samples.iter().zip(&counts) {
