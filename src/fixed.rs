@@ -109,6 +109,16 @@ impl QuatQ30 {
         q
     }
 
+    /// The conjugate (the inverse rotation of a unit quaternion).
+    pub const fn conjugate(self) -> QuatQ30 {
+        QuatQ30 {
+            w: self.w,
+            x: self.x.saturating_neg(),
+            y: self.y.saturating_neg(),
+            z: self.z.saturating_neg(),
+        }
+    }
+
     /// |q|² in Q30.
     pub const fn norm2_q30(self) -> i64 {
         (self.w as i64 * self.w as i64

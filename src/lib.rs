@@ -50,10 +50,13 @@
 #![deny(missing_docs)]
 
 pub mod fixed;
+pub mod foot_frame;
 pub mod mean_filter;
 pub mod mpu6050;
+pub mod phases;
 pub mod pipeline;
 pub mod rate;
+pub mod rest;
 pub mod sample;
 pub mod stance;
 pub mod stride;

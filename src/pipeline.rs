@@ -1,16 +1,33 @@
-//! The per-sample pipeline: mean filter → stance detector → stride tracker (phases, ZUPT
-//! length), composed in that order, each stage fed only the output of the one before.
+//! The per-sample pipeline, composed in card order:
+//!
+//! ```text
+//! raw sample ─┬─ mean filter ─┬─ rest test ─→ foot-frame estimator ─┐ (frame)
+//!             │               └──────────── rotate into the foot frame ─→ stance detector
+//!             └─ delay line ───────────────────────────────────────────→ stride tracker
+//!                                                      (phases, ZUPT length, flags)
+//! ```
+//!
+//! Each stage is fed only the records of the stage before it. The delays of the centred
+//! windows are undone by delay lines, so that every stride index is the number of the raw
+//! sample it names.
 
+use crate::foot_frame::FootFrameEstimator;
 use crate::mean_filter::MeanFilter;
+use crate::phases::PhaseMethod;
 use crate::rate::SampleRate;
+use crate::rest::{RestDetector, RestThresholds};
 use crate::sample::{AccelRange, GyroRange, RawSample};
 use crate::stance::{StanceDetector, StanceThresholds};
 use crate::stride::{Stride, StrideTracker};
 
-/// Window of the mean filter ahead of the stance detector (4 samples: 20 ms at 200 Hz).
-pub const MEAN_FILTER_LEN: usize = 4;
-/// Capacity of the delay line that aligns raw samples with the (centred) stance decision.
-pub const DELAY_CAPACITY: usize = 64;
+/// Capacity of the mean filter; the window used is the power of two nearest
+/// [`MEAN_FILTER_MS`] at the sample rate, at most this.
+pub const MEAN_FILTER_CAPACITY: usize = 16;
+/// Mean-filter window, ms (4 samples at 200 Hz, 16 at 1 kHz).
+pub const MEAN_FILTER_MS: u32 = 20;
+/// Capacity of the delay lines that align raw samples and foot-frame samples with the
+/// (centred) stance decision: ≥ stance delay (63) + filter delay (7) + 1.
+pub const DELAY_CAPACITY: usize = 128;
 
 /// What the pipeline needs to know about the data.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -21,52 +38,93 @@ pub struct Config {
     pub accel: AccelRange,
     /// Gyroscope range the counts are in.
     pub gyro: GyroRange,
+    /// Phase splitter version.
+    pub phases: PhaseMethod,
+}
+
+impl Config {
+    /// The default configuration for data at `rate` in the given ranges: the augmented
+    /// phase splitter.
+    pub const fn new(rate: SampleRate, accel: AccelRange, gyro: GyroRange) -> Self {
+        Config {
+            rate,
+            accel,
+            gyro,
+            phases: PhaseMethod::Augmented,
+        }
+    }
+}
+
+const fn log2_nearest(n: u32) -> u32 {
+    // Largest power of two ≤ n, moved up when n is nearer the next one.
+    let mut k = 0;
+    while k < 31 && (1u32 << (k + 1)) <= n {
+        k += 1;
+    }
+    if k < 31 && n - (1 << k) > (1 << (k + 1)) - n {
+        k + 1
+    } else {
+        k
+    }
 }
 
 /// From raw samples to strides.
 #[derive(Clone, Debug)]
 pub struct Pipeline {
-    filter: MeanFilter<MEAN_FILTER_LEN>,
+    filter: MeanFilter<MEAN_FILTER_CAPACITY>,
+    rest: RestDetector,
+    frame: FootFrameEstimator,
     stance: StanceDetector,
     tracker: StrideTracker,
-    delay_line: [RawSample; DELAY_CAPACITY],
-    /// Samples between an input and the sample its stance decision is about.
+    raw_line: [RawSample; DELAY_CAPACITY],
+    foot_line: [[i16; 3]; DELAY_CAPACITY],
+    /// Samples between an input and the raw sample the rest decision is about.
+    rest_delay: u32,
+    /// Samples between an input and the raw sample the stance decision is about.
     delay: u32,
     /// Number of the next input sample.
     next: u32,
     /// Inputs since the last reset (start or gap).
     since_reset: u32,
+    /// Inputs fed to the stance detector since the last reset.
+    stance_fed: u32,
     last_decision: bool,
 }
 
 impl Pipeline {
     /// A pipeline for data described by `config`.
     pub const fn new(config: Config) -> Self {
-        let stance = StanceDetector::new(StanceThresholds::new(
-            config.rate,
-            config.accel,
-            config.gyro,
+        let filter = MeanFilter::with_len_log2(log2_nearest(
+            config.rate.samples_in_ms(MEAN_FILTER_MS),
         ));
-        // The window is centred on sample n − W/2; the mean filter adds (N − 1)/2, rounded up.
-        let delay = stance.delay() + (MEAN_FILTER_LEN as u32) / 2;
+        let rest = RestDetector::new(RestThresholds::new(config.rate, config.accel, config.gyro));
+        let stance = StanceDetector::new(StanceThresholds::new(config.rate, config.gyro));
+        let rest_delay = rest.delay() + filter.delay();
+        let delay = stance.delay() + filter.delay();
         Pipeline {
-            filter: MeanFilter::new(),
+            filter,
+            rest,
+            frame: FootFrameEstimator::new(config.rate, config.accel),
             stance,
-            tracker: StrideTracker::new(config.rate, config.gyro),
-            delay_line: [RawSample {
+            tracker: StrideTracker::new(config.rate, config.gyro, config.phases),
+            raw_line: [RawSample {
                 accel: [0; 3],
                 gyro: [0; 3],
                 temp: 0,
             }; DELAY_CAPACITY],
+            foot_line: [[0; 3]; DELAY_CAPACITY],
+            rest_delay,
             delay,
             next: 0,
             since_reset: 0,
+            stance_fed: 0,
             last_decision: false,
         }
     }
 
-    /// Latency of the pipeline in samples: a stride ending at foot-flat sample `n` is
-    /// returned by the call that feeds sample `n + latency`.
+    /// Latency of the stance decision in samples. A stride is reported when the stance
+    /// after it ends: by the call that feeds the next heel-off + `latency`, or
+    /// [`crate::stride::MAX_STANCE_IN_STRIDE_MS`] into that stance + `latency`.
     pub const fn latency(&self) -> u32 {
         self.delay
     }
@@ -76,47 +134,78 @@ impl Pipeline {
         self.next
     }
 
-    /// Feeds one sample; returns a stride when one has just ended.
+    /// The foot frame found so far, if any.
+    pub const fn foot_frame(&self) -> Option<crate::foot_frame::FootFrame> {
+        self.frame.frame()
+    }
+
+    /// Feeds one sample; returns a stride when one can be reported.
     pub fn process(&mut self, s: &RawSample) -> Option<Stride> {
         let index = self.next;
         self.next = self.next.wrapping_add(1);
-        self.delay_line[index as usize & (DELAY_CAPACITY - 1)] = *s;
+        let slot = |i: u32| i as usize & (DELAY_CAPACITY - 1);
+        self.raw_line[slot(index)] = *s;
         self.since_reset = self.since_reset.saturating_add(1);
-        let f_accel = self.filter.process(s.accel);
-        let decision = self.stance.process(f_accel, s.gyro)?;
+        let filtered = self.filter.process(s.accel);
+        if let Some(rest) = self.rest.process(filtered, s.gyro) {
+            if self.since_reset > self.rest_delay {
+                let at = index.wrapping_sub(self.rest_delay);
+                self.frame.process(&self.raw_line[slot(at)], rest);
+            }
+        }
+        let frame = self.frame.frame()?;
+        let foot = frame.apply(filtered);
+        self.foot_line[slot(index)] = foot;
+        let decision = self.stance.process(foot, s.gyro)?;
+        self.stance_fed = self.stance_fed.saturating_add(1);
         self.last_decision = decision;
         if self.since_reset <= self.delay {
             return None;
         }
         let at = index.wrapping_sub(self.delay);
-        let aligned = self.delay_line[at as usize & (DELAY_CAPACITY - 1)];
-        self.tracker.process(at, &aligned, decision)
+        let foot_at = index.wrapping_sub(self.stance.delay());
+        let (raw, foot) = (self.raw_line[slot(at)], self.foot_line[slot(foot_at)]);
+        self.tracker.process(at, &raw, foot, decision)
     }
 
-    /// Declares `missing` samples lost (FIFO overflow, a jump in timestamps): the stride in
-    /// progress is dropped, since no length over a gap can be trusted, and detection
-    /// restarts after it.
-    pub fn gap(&mut self, missing: u32) {
+    /// Declares `missing` samples lost (FIFO overflow, a jump in timestamps): the movement
+    /// in progress is dropped, since no length over a gap can be trusted, and detection
+    /// restarts after it. Returns the last stride closed before the gap, still held.
+    pub fn gap(&mut self, missing: u32) -> Option<Stride> {
         self.next = self.next.wrapping_add(missing);
         self.since_reset = 0;
-        self.filter = MeanFilter::new();
+        self.stance_fed = 0;
+        self.filter = MeanFilter::with_len_log2(self.filter.window().trailing_zeros());
+        self.rest.reset();
         self.stance.reset();
-        self.tracker.reset();
+        self.tracker.reset()
     }
 
     /// Drains the samples still in the delay line at the end of a recording, with the last
-    /// stance decision; returns the stride they close, if any.
-    pub fn finish(&mut self) -> Option<Stride> {
-        let pending = self.delay.min(self.since_reset.saturating_sub(1));
-        let mut out = None;
+    /// stance decision, and returns the strides still held (at most two: one closed by the
+    /// drained samples, one waiting for its following stance to end).
+    pub fn finish(&mut self) -> [Option<Stride>; 2] {
+        let mut out = [None, None];
+        // The tracker has had samples up to `next − 1 − delay`; the foot-frame values reach
+        // `next − 1 − filter delay`, so that many more can be drained.
+        let fd = self.filter.delay();
+        let pending = if self.stance_fed == 0 {
+            0
+        } else {
+            self.stance.delay()
+        };
+        let slot = |i: u32| i as usize & (DELAY_CAPACITY - 1);
         for k in (0..pending).rev() {
-            let at = self.next.wrapping_sub(1).wrapping_sub(k);
-            let s = self.delay_line[at as usize & (DELAY_CAPACITY - 1)];
-            if let Some(st) = self.tracker.process(at, &s, self.last_decision) {
-                out = Some(st);
+            let at = self.next.wrapping_sub(1 + fd).wrapping_sub(k);
+            let foot_at = at.wrapping_add(fd);
+            let (raw, foot) = (self.raw_line[slot(at)], self.foot_line[slot(foot_at)]);
+            if let Some(st) = self.tracker.process(at, &raw, foot, self.last_decision) {
+                out[0] = Some(st);
             }
         }
+        out[1] = self.tracker.finish();
         self.since_reset = 0;
+        self.stance_fed = 0;
         out
     }
 }

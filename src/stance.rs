@@ -1,60 +1,152 @@
-//! Stance (zero-velocity) detector: is the foot flat on the ground?
+//! Stance (zero-velocity) detector after Huang et al. 2022, §2.3.2 and §4.
 //!
-//! First version, orientation-free: over a sliding window of `W` samples (≈ 50 ms) the foot
-//! is at rest when both
-//! - the total variance of the (mean-filtered) specific force, `Σ_axes var(a)`, is under
-//!   [`ACCEL_STD_MAX_MMPS2`]², and
-//! - the mean angular-rate energy `mean(|ω|²)` is under [`GYRO_RMS_MAX_MRADPS`]²,
+//! Input: mean-filtered acceleration in the foot frame ([`crate::foot_frame`]), vertical
+//! with gravity removed and sagittal, plus the angular-rate energy `|ω|²`.
 //!
-//! the accelerometer and gyroscope halves of the SHOE detector (Skog et al. 2010). Neither
-//! statistic depends on how the clip is mounted. Thresholds are set in physical units and
-//! converted to counts for the configured ranges; the window follows the sample rate.
+//! 1. **Deflation.** Each acceleration `x` becomes `x·|x|` (squared, sign kept): stance,
+//!    near zero, shrinks further; the push-off, swing and impact grow.
+//! 2. **Volatility, variance.** Huang's answer to fast walking (§4), where a short stance
+//!    looks like a slow swing: the variance of the deflated signal is averaged over three
+//!    centred windows of 30, 60 and 120 ms (their 3, 6 and 12 samples at 100 Hz).
+//! 3. **Volatility, interquartile range** of the deflated signal over the 60 ms window (kept
+//!    sorted incrementally: one binary search and one shift per sample).
+//! 4. **Angular rate**, as the SHOE and GLRT detectors add: mean `|ω|²` over the 60 ms window.
+//!
+//! The foot is in stance when, on both axes, variance and IQR are under their thresholds
+//! and the angular-rate energy is under its own.
+//!
+//! ## Thresholds and how they were chosen
+//!
+//! In physical units, converted to the configured ranges in [`StanceThresholds::new`]; the
+//! windows follow the sample rate. Quiet standing and foot-flat give deflated standard
+//! deviations well under 1 (m/s²)²; push-off, swing and impact reach 25–900 (m/s²)². The
+//! values were set with `gaitclip eval` on all three datasets of `../shared/datasets`,
+//! sweeping (std, IQR, gyro) over (0.8, 0.8, 0.9), (1.5, 1.5, 0.7), (3, 3, 0.9),
+//! (6, 6, 1.2), (6, 6, 2.0) and (10, 10, 1.5) in (m/s²)² and rad/s: stride F1 on
+//! `pyshoe_vicon` rose from 0.73 to 0.90 up to (6, 6, 1.2) and `ipol_gait_events` peaked
+//! there (0.931); larger thresholds merged the short stances of fast walking and running.
 
+use crate::foot_frame::FOOT_LSB_PER_G;
 use crate::rate::SampleRate;
-use crate::sample::{AccelRange, GyroRange};
+use crate::sample::GyroRange;
 
-/// Window length in milliseconds (5 samples at 100 Hz, as SHOE uses).
-pub const WINDOW_MS: u32 = 50;
-/// Capacity of the window ring, a power of two ≥ the longest window (50 ms at 1 kHz).
-pub const WINDOW_CAPACITY: usize = 64;
-/// Stance: standard deviation of the specific force (all axes together) under 0.6 m/s².
-/// Walking swing stays above 3 m/s²; standing with a wobble stays under 0.3 m/s².
-pub const ACCEL_STD_MAX_MMPS2: u32 = 600;
-/// Stance: RMS angular rate under 0.7 rad/s (40 °/s). Mid-swing exceeds 5 rad/s; a flat
-/// foot that rolls over stays under 0.5 rad/s on the recordings in `../shared/datasets`.
-pub const GYRO_RMS_MAX_MRADPS: u32 = 700;
+/// Half-widths of the three windows, ms (full windows 2·h + 1 samples: 30, 60, 120 ms).
+pub const HALF_WINDOW_MS: [u32; 3] = [15, 30, 60];
+/// Ring capacity: ≥ 2·(60 ms at 1 kHz) + 2.
+pub const RING_CAPACITY: usize = 128;
+/// Capacity of the sorted IQR window: ≥ 2·(30 ms at 1 kHz) + 1.
+pub const IQR_CAPACITY: usize = 64;
+/// Stance: standard deviation of the deflated acceleration (variance averaged over the
+/// three windows) under this many milli-(m/s²)²: 6 (m/s²)², a swing-level |a| of 2.4 m/s².
+pub const DEFLATED_STD_MAX: u32 = 6000;
+/// Stance: interquartile range of the deflated acceleration under this many
+/// milli-(m/s²)².
+pub const DEFLATED_IQR_MAX: u32 = 6000;
+/// Stance: RMS angular rate over the 60 ms window under 1.2 rad/s (69 °/s).
+pub const GYRO_RMS_MAX_MRADPS: u32 = 1200;
 
-/// Thresholds of the detector, in counts of the configured ranges.
+/// Deflated units per (m/s²)²: deflated values are `x·|x| / 2048` for `x` in g/2048, i.e.
+/// 2048/9.80665² per (m/s²)², times 2^DEFLATE_SHIFT for precision.
+const DEFLATE_SHIFT: u32 = 3;
+
+/// Thresholds and windows of the detector, in the units it computes in.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct StanceThresholds {
-    /// Window length in samples (3..=63).
-    pub window: u32,
-    /// Variance threshold, counts².
-    pub accel_var_counts2: i64,
-    /// Energy threshold, counts².
+    /// Half-widths of the three windows, samples.
+    pub half: [u32; 3],
+    /// Variance threshold, deflated units².
+    pub variance: i64,
+    /// IQR threshold, deflated units.
+    pub iqr: i64,
+    /// Angular-rate energy threshold, counts².
     pub gyro_energy_counts2: i64,
 }
 
 impl StanceThresholds {
-    /// Thresholds for a sample rate and sensor ranges.
-    pub const fn new(rate: SampleRate, accel: AccelRange, gyro: GyroRange) -> Self {
-        let window = rate.samples_in_ms(WINDOW_MS);
-        let window = if window < 3 {
-            3
-        } else if window > WINDOW_CAPACITY as u32 - 1 {
-            WINDOW_CAPACITY as u32 - 1
-        } else {
-            window
-        };
-        // m/s² → counts: · lsb_per_g / 9.80665.
-        let a = ACCEL_STD_MAX_MMPS2 as i64 * accel.lsb_per_g() as i64 / 9807;
-        // rad/s → counts: · (180/π) · lsb_per_dps (lsb10 / 10); 18/(π·1000) = 1800/314159.
+    /// Thresholds for a sample rate and gyro range.
+    pub const fn new(rate: SampleRate, gyro: GyroRange) -> Self {
+        let mut half = [0u32; 3];
+        let mut k = 0;
+        while k < 3 {
+            let h = rate.samples_in_ms(HALF_WINDOW_MS[k]);
+            half[k] = if h < 1 {
+                1
+            } else if h as usize > (RING_CAPACITY - 2) / 2 {
+                ((RING_CAPACITY - 2) / 2) as u32
+            } else {
+                h
+            };
+            k += 1;
+        }
+        if half[1] as usize > (IQR_CAPACITY - 1) / 2 {
+            half[1] = ((IQR_CAPACITY - 1) / 2) as u32;
+        }
+        // milli-(m/s²)² → deflated units: · 2048·2^DEFLATE_SHIFT / 9.80665² / 1000.
+        // 9.80665² · 10⁵ = 9 617 038.
+        let num = FOOT_LSB_PER_G as i64 * (1 << DEFLATE_SHIFT) * 100;
+        let std = DEFLATED_STD_MAX as i64 * num / 9_617_038;
+        let iqr = DEFLATED_IQR_MAX as i64 * num / 9_617_038;
         let g = GYRO_RMS_MAX_MRADPS as i64 * gyro.lsb_per_dps_x10() as i64 * 1800 / 314_159;
         StanceThresholds {
-            window,
-            accel_var_counts2: a * a,
+            half,
+            variance: std * std,
+            iqr,
             gyro_energy_counts2: g * g,
         }
+    }
+
+    /// Delay between the newest input and the sample the answer is about.
+    pub const fn delay(&self) -> u32 {
+        self.half[2]
+    }
+}
+
+/// Deflate `x` (g/2048): `x·|x|·2^DEFLATE_SHIFT/2048` (floor), range ±2²² for `i16` input.
+pub const fn deflate(x: i16) -> i32 {
+    let x = x as i32;
+    (x * x.abs()) >> (11 - DEFLATE_SHIFT)
+}
+
+/// A window kept sorted as samples enter and leave.
+#[derive(Clone, Debug)]
+struct SortedWindow {
+    values: [i32; IQR_CAPACITY],
+    len: usize,
+}
+
+impl SortedWindow {
+    const fn new() -> Self {
+        SortedWindow {
+            values: [0; IQR_CAPACITY],
+            len: 0,
+        }
+    }
+
+    fn insert(&mut self, v: i32) {
+        if self.len >= IQR_CAPACITY {
+            return;
+        }
+        let at = self.values[..self.len].partition_point(|&x| x < v);
+        self.values.copy_within(at..self.len, at + 1);
+        self.values[at] = v;
+        self.len += 1;
+    }
+
+    fn remove(&mut self, v: i32) {
+        let at = self.values[..self.len].partition_point(|&x| x < v);
+        if at < self.len && self.values[at] == v {
+            self.values.copy_within(at + 1..self.len, at);
+            self.len -= 1;
+        }
+    }
+
+    /// Interquartile range by nearest rank: `x[⌊3(n−1)/4⌋] − x[⌊(n−1)/4⌋]`.
+    fn iqr(&self) -> i64 {
+        if self.len == 0 {
+            return 0;
+        }
+        let n = self.len - 1;
+        self.values[3 * n / 4] as i64 - self.values[n / 4] as i64
     }
 }
 
@@ -62,13 +154,16 @@ impl StanceThresholds {
 #[derive(Clone, Debug)]
 pub struct StanceDetector {
     thresholds: StanceThresholds,
-    accel: [[i16; 3]; WINDOW_CAPACITY],
-    accel_sq: [i64; WINDOW_CAPACITY],
-    gyro_sq: [i64; WINDOW_CAPACITY],
-    sum_a: [i64; 3],
-    sum_a_sq: i64,
-    sum_g_sq: i64,
-    head: usize,
+    /// Deflated vertical and sagittal acceleration.
+    ring: [[i32; 2]; RING_CAPACITY],
+    gyro: [i64; RING_CAPACITY],
+    sum: [[i64; 2]; 3],
+    sum_sq: [[i64; 2]; 3],
+    gyro_sum: i64,
+    sorted: [SortedWindow; 2],
+    /// Number of the next input (ring position).
+    n: u32,
+    /// Inputs since the start, saturating.
     seen: u32,
 }
 
@@ -77,63 +172,92 @@ impl StanceDetector {
     pub const fn new(thresholds: StanceThresholds) -> Self {
         StanceDetector {
             thresholds,
-            accel: [[0; 3]; WINDOW_CAPACITY],
-            accel_sq: [0; WINDOW_CAPACITY],
-            gyro_sq: [0; WINDOW_CAPACITY],
-            sum_a: [0; 3],
-            sum_a_sq: 0,
-            sum_g_sq: 0,
-            head: 0,
+            ring: [[0; 2]; RING_CAPACITY],
+            gyro: [0; RING_CAPACITY],
+            sum: [[0; 2]; 3],
+            sum_sq: [[0; 2]; 3],
+            gyro_sum: 0,
+            sorted: [SortedWindow::new(), SortedWindow::new()],
+            n: 0,
             seen: 0,
         }
     }
 
-    /// Forgets the history (after a gap in the samples).
+    /// Forgets the history (after a gap).
     pub fn reset(&mut self) {
         *self = StanceDetector::new(self.thresholds);
     }
 
-    /// Samples of delay between the newest input and the centre of the window the answer
-    /// describes.
+    /// Samples between the newest input and the centre of the windows.
     pub const fn delay(&self) -> u32 {
-        self.thresholds.window / 2
+        self.thresholds.delay()
     }
 
-    /// Pushes one filtered sample; returns `Some(stance)` for the window ending here, `None`
-    /// until the window is full.
-    pub fn process(&mut self, accel: [i16; 3], gyro: [i16; 3]) -> Option<bool> {
-        let w = self.thresholds.window as usize;
-        let slot = self.head & (WINDOW_CAPACITY - 1);
-        let leaving = (self.head + WINDOW_CAPACITY - w) & (WINDOW_CAPACITY - 1);
-        let a_sq: i64 = accel.iter().map(|&v| v as i64 * v as i64).sum();
-        let g_sq: i64 = gyro.iter().map(|&v| v as i64 * v as i64).sum();
-        self.accel[slot] = accel;
-        self.accel_sq[slot] = a_sq;
-        self.gyro_sq[slot] = g_sq;
-        for (s, &v) in self.sum_a.iter_mut().zip(accel.iter()) {
-            *s += v as i64;
-        }
-        self.sum_a_sq += a_sq;
-        self.sum_g_sq += g_sq;
-        if self.seen as usize >= w {
-            for (s, &v) in self.sum_a.iter_mut().zip(self.accel[leaving].iter()) {
-                *s -= v as i64;
+    /// Pushes one sample: `foot` is the foot-frame acceleration `[forward, left, up − g]`
+    /// in g/2048 and `gyro` the raw angular rate (counts). Returns `Some(stance)` about the
+    /// sample [`StanceDetector::delay`] inputs back, `None` until the windows are full.
+    pub fn process(&mut self, foot: [i16; 3], gyro: [i16; 3]) -> Option<bool> {
+        let n = self.n;
+        let seen = self.seen;
+        self.n = self.n.wrapping_add(1);
+        self.seen = self.seen.saturating_add(1);
+        let slot = |i: u32| i as usize & (RING_CAPACITY - 1);
+        self.ring[slot(n)] = [deflate(foot[2]), deflate(foot[0])];
+        self.gyro[slot(n)] = gyro.iter().map(|&v| v as i64 * v as i64).sum();
+        let big = self.thresholds.half[2];
+        // The centre is `big` inputs back; window k spans centre ± half[k].
+        let centre = n.wrapping_sub(big);
+        for k in 0..3 {
+            let h = self.thresholds.half[k];
+            let entering = centre.wrapping_add(h);
+            let leaving = centre.wrapping_sub(h + 1);
+            let seen_entering = seen >= big - h;
+            let seen_leaving = seen > big + h;
+            if seen_entering {
+                let v = self.ring[slot(entering)];
+                for a in 0..2 {
+                    self.sum[k][a] += v[a] as i64;
+                    self.sum_sq[k][a] += v[a] as i64 * v[a] as i64;
+                }
+                if k == 1 {
+                    self.gyro_sum += self.gyro[slot(entering)];
+                    for a in 0..2 {
+                        self.sorted[a].insert(v[a]);
+                    }
+                }
             }
-            self.sum_a_sq -= self.accel_sq[leaving];
-            self.sum_g_sq -= self.gyro_sq[leaving];
-        } else {
-            self.seen += 1;
+            if seen_leaving {
+                let v = self.ring[slot(leaving)];
+                for a in 0..2 {
+                    self.sum[k][a] -= v[a] as i64;
+                    self.sum_sq[k][a] -= v[a] as i64 * v[a] as i64;
+                }
+                if k == 1 {
+                    self.gyro_sum -= self.gyro[slot(leaving)];
+                    for a in 0..2 {
+                        self.sorted[a].remove(v[a]);
+                    }
+                }
+            }
         }
-        self.head = (self.head + 1) & (WINDOW_CAPACITY - 1);
-        if (self.seen as usize) < w {
+        if seen < 2 * big {
             return None;
         }
-        let w = w as i64;
-        // W²·var_total = W·Σ|a|² − |Σa|²; both terms < 2^44 for W < 64 and i16 inputs.
-        let sum_sq_of_sum: i64 = self.sum_a.iter().map(|&s| s * s).sum();
-        let var_w2 = w * self.sum_a_sq - sum_sq_of_sum;
-        let still_accel = var_w2 < self.thresholds.accel_var_counts2 * w * w;
-        let still_gyro = self.sum_g_sq < self.thresholds.gyro_energy_counts2 * w;
-        Some(still_accel && still_gyro)
+        let t = &self.thresholds;
+        let mut still = true;
+        for a in 0..2 {
+            // Mean of the three variances; W·Σx² and (Σx)² < 2⁶¹ for W ≤ 127.
+            let mut var_x3 = 0i64;
+            for k in 0..3 {
+                let w = 2 * t.half[k] as i64 + 1;
+                let s = self.sum[k][a];
+                var_x3 += (w * self.sum_sq[k][a] - s * s) / (w * w);
+            }
+            still &= var_x3 < 3 * t.variance;
+            still &= self.sorted[a].iqr() < t.iqr;
+        }
+        let w1 = 2 * t.half[1] as i64 + 1;
+        still &= self.gyro_sum < t.gyro_energy_counts2 * w1;
+        Some(still)
     }
 }

@@ -7,16 +7,28 @@
 //!  |---- stance -------|-- push-off --|----- swing -----|-- heel-strike --|
 //! ```
 //!
-//! First version of the phase boundaries (orientation-free): toe-off is the largest specific
-//! force in the first half of the movement (the push-off burst), heel-strike the largest in
-//! the second half (the impact). The length is the ZUPT displacement of the movement.
+//! Heel-off and foot-flat are the edges of the stances ([`crate::stance`]); toe-off and
+//! heel-strike come from Huang's splitter ([`crate::phases`]) run on the movement's
+//! foot-frame acceleration; the length is the ZUPT displacement of the movement
+//! ([`crate::zupt`]).
 //!
-//! Streaming and bounded: the only per-stride memory is the magnitude of each movement
-//! sample, [`MAX_MOVEMENT_SAMPLES`] of them; a longer movement is still closed at the next
-//! stance but flagged [`StrideFlags::TOO_LONG`].
+//! **What is and is not a stride.** A movement shorter than [`MIN_MOVEMENT_MS`] is a wobble
+//! of a foot on the ground and merges into the stance; standing still therefore yields no
+//! strides at all. The first step after standing is flagged [`StrideFlags::FROM_REST`], the
+//! last one before standing (the final half-stride) [`StrideFlags::TO_REST`], and a stride
+//! whose heading changed by more than 45° (a turn, or turning on the spot)
+//! [`StrideFlags::TURN`]. To know whether a stride was the last one, a stride is reported
+//! when the stance after it ends (the next heel-off), or once that stance has lasted
+//! [`MAX_STANCE_IN_STRIDE_MS`]: the latency is the following stance, at most one second.
+//! A gap in the samples drops the movement in progress: no stride is ever emitted across one.
+//!
+//! Streaming and bounded: the only per-stride memory is the movement's foot-frame
+//! acceleration, [`MAX_MOVEMENT_SAMPLES`] samples; a longer movement is still closed at the
+//! next stance but flagged [`StrideFlags::TOO_LONG`] and split on what was kept.
 
 use heapless::Vec;
 
+use crate::phases::{self, PhaseMethod};
 use crate::rate::SampleRate;
 use crate::sample::{GyroRange, RawSample};
 use crate::zupt::ZuptIntegrator;
@@ -41,6 +53,14 @@ impl StrideFlags {
     /// The stride starts from a stance longer than [`MAX_STANCE_IN_STRIDE_MS`]: the first
     /// step after standing (informational).
     pub const FROM_REST: u8 = 1 << 2;
+    /// The stance after the stride lasted longer than [`MAX_STANCE_IN_STRIDE_MS`], or the
+    /// recording ended in it: the last step before standing, often a half-stride.
+    pub const TO_REST: u8 = 1 << 3;
+    /// The heading changed by more than 45° over the movement: a turn.
+    pub const TURN: u8 = 1 << 4;
+    /// The phase splitter found no major peak-valley pair for a boundary: toe-off and
+    /// heel-strike are cluster centres, not measured events.
+    pub const PHASES_GUESSED: u8 = 1 << 5;
     /// Flags that make a length untrustworthy.
     pub const INVALID: u8 = Self::SATURATED | Self::TOO_LONG;
 
@@ -98,9 +118,13 @@ pub struct StrideTracker {
     accel_sum: [i64; 3],
     gyro_sum: [i64; 3],
     stance_samples: u32,
-    magnitude: Vec<u32, MAX_MOVEMENT_SAMPLES>,
+    movement: Vec<[i16; 2], MAX_MOVEMENT_SAMPLES>,
     flags: u8,
     next_index: u32,
+    phase_method: PhaseMethod,
+    merge_samples: u32,
+    /// The last closed stride, held until the stance after it ends.
+    pending: Option<Stride>,
 }
 
 /// Stance accumulators are halved at this count so that standing for hours cannot overflow
@@ -108,8 +132,8 @@ pub struct StrideTracker {
 const STANCE_SUM_HALVING_AT: u32 = 1 << 16;
 
 impl StrideTracker {
-    /// A tracker for a sample rate and gyro range.
-    pub const fn new(rate: SampleRate, gyro: GyroRange) -> Self {
+    /// A tracker for a sample rate and gyro range, splitting phases with `phase_method`.
+    pub const fn new(rate: SampleRate, gyro: GyroRange, phase_method: PhaseMethod) -> Self {
         StrideTracker {
             state: State::Unprimed,
             min_movement: rate.samples_in_ms(MIN_MOVEMENT_MS),
@@ -120,16 +144,29 @@ impl StrideTracker {
             accel_sum: [0; 3],
             gyro_sum: [0; 3],
             stance_samples: 0,
-            magnitude: Vec::new(),
+            movement: Vec::new(),
             flags: 0,
             next_index: 0,
+            phase_method,
+            merge_samples: rate.samples_in_ms(phases::MERGE_MS),
+            pending: None,
         }
     }
 
-    /// Drops any stride in progress and waits for the next stance (after a gap).
-    pub fn reset(&mut self) {
+    /// Drops the movement in progress and waits for the next stance (after a gap); returns
+    /// the last stride closed before the gap, which is complete and was still held.
+    pub fn reset(&mut self) -> Option<Stride> {
         self.state = State::Unprimed;
         self.clear_stance();
+        self.pending.take()
+    }
+
+    /// Returns the stride still held at the end of a recording: the recording ended in the
+    /// stance after it, so it is the last before rest.
+    pub fn finish(&mut self) -> Option<Stride> {
+        let mut s = self.pending.take()?;
+        s.flags.0 |= StrideFlags::TO_REST;
+        Some(s)
     }
 
     fn clear_stance(&mut self) {
@@ -138,8 +175,16 @@ impl StrideTracker {
         self.stance_samples = 0;
     }
 
-    /// Feeds sample number `index`, its raw values and whether the foot is at rest there.
-    pub fn process(&mut self, index: u32, s: &RawSample, stance: bool) -> Option<Stride> {
+    /// Feeds sample number `index`: its raw values, its mean-filtered foot-frame
+    /// acceleration `[forward, left, up − g]` (g/2048) and whether the foot is in stance.
+    /// Returns the stride, if any, that this sample lets it report.
+    pub fn process(
+        &mut self,
+        index: u32,
+        s: &RawSample,
+        foot: [i16; 3],
+        stance: bool,
+    ) -> Option<Stride> {
         match (self.state, stance) {
             (State::Unprimed, false) => None,
             (State::Unprimed, true) => {
@@ -151,6 +196,12 @@ impl StrideTracker {
             }
             (State::Stance, true) => {
                 self.accumulate_stance(s);
+                if index.wrapping_sub(self.stance_start) > self.max_stance {
+                    return self.pending.take().map(|mut st| {
+                        st.flags.0 |= StrideFlags::TO_REST;
+                        st
+                    });
+                }
                 None
             }
             (State::Stance, false) => {
@@ -160,14 +211,15 @@ impl StrideTracker {
                 {
                     self.state = State::Moving;
                     self.heel_off = index;
-                    self.magnitude.clear();
+                    self.movement.clear();
                     self.flags = 0;
-                    self.accumulate_movement(s);
+                    self.accumulate_movement(s, foot);
+                    return self.pending.take();
                 }
                 None
             }
             (State::Moving, false) => {
-                self.accumulate_movement(s);
+                self.accumulate_movement(s, foot);
                 None
             }
             (State::Moving, true) => {
@@ -182,7 +234,9 @@ impl StrideTracker {
                 self.stance_start = index;
                 self.clear_stance();
                 self.accumulate_stance(s);
-                Some(stride)
+                // A stride still held here had no stance after it long enough to end it:
+                // cannot happen (a stance always precedes a movement), but never lose one.
+                self.pending.replace(stride)
             }
         }
     }
@@ -200,14 +254,9 @@ impl StrideTracker {
         self.stance_samples += 1;
     }
 
-    fn accumulate_movement(&mut self, s: &RawSample) {
+    fn accumulate_movement(&mut self, s: &RawSample, foot: [i16; 3]) {
         self.zupt.process(s);
-        let m: u32 = s
-            .accel
-            .iter()
-            .map(|&v| (v as i32 * v as i32) as u32)
-            .fold(0u32, u32::saturating_add);
-        if self.magnitude.push(m).is_err() {
+        if self.movement.push([foot[2], foot[0]]).is_err() {
             self.flags |= StrideFlags::TOO_LONG;
         }
         if s.is_saturated() {
@@ -216,23 +265,15 @@ impl StrideTracker {
     }
 
     fn close(&mut self, foot_flat: u32) -> Stride {
-        let half = self.magnitude.len() / 2;
-        let argmax = |xs: &[u32]| {
-            xs.iter()
-                .enumerate()
-                .fold(
-                    (0usize, 0u32),
-                    |best, (i, &v)| if v > best.1 { (i, v) } else { best },
-                )
-                .0 as u32
-        };
-        let toe_off = self.heel_off.wrapping_add(argmax(&self.magnitude[..half]));
-        let heel_strike = self
-            .heel_off
-            .wrapping_add(half as u32)
-            .wrapping_add(argmax(&self.magnitude[half..]));
-        let stance = self.heel_off.wrapping_sub(self.stance_start);
+        let split = phases::split(&self.movement, self.phase_method, self.merge_samples);
         let mut flags = self.flags;
+        if !split.found {
+            flags |= StrideFlags::PHASES_GUESSED;
+        }
+        if self.zupt.turned_over_45_deg() {
+            flags |= StrideFlags::TURN;
+        }
+        let stance = self.heel_off.wrapping_sub(self.stance_start);
         let start = if stance > self.max_stance {
             flags |= StrideFlags::FROM_REST;
             self.heel_off.wrapping_sub(self.max_stance)
@@ -246,8 +287,8 @@ impl StrideTracker {
             index,
             start,
             heel_off: self.heel_off,
-            toe_off,
-            heel_strike,
+            toe_off: self.heel_off.wrapping_add(split.toe_off),
+            heel_strike: self.heel_off.wrapping_add(split.heel_strike),
             end: foot_flat,
             length_mm: ((d.horizontal_um + 500) / 1000).min(u32::MAX as u64) as u32,
             climb_mm: ((d.vertical_um + 500).div_euclid(1000))

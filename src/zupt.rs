@@ -38,6 +38,7 @@ pub struct ZuptIntegrator {
     half_angle_per_count_q46: i64,
     rate: SampleRate,
     attitude: QuatQ30,
+    start_attitude: QuatQ30,
     gyro_bias: [i32; 3],
     gravity_q8: i64,
     velocity_q8: [i64; 3],
@@ -55,6 +56,7 @@ impl ZuptIntegrator {
             half_angle_per_count_q46: ((num + den / 2) / den) as i64,
             rate,
             attitude: QuatQ30::IDENTITY,
+            start_attitude: QuatQ30::IDENTITY,
             gyro_bias: [0; 3],
             gravity_q8: 0,
             velocity_q8: [0; 3],
@@ -80,6 +82,7 @@ impl ZuptIntegrator {
             return false;
         }
         self.attitude = level;
+        self.start_attitude = level;
         self.gyro_bias = gyro_sum.map(|s| div_round_i128(s as i128, n as i128) as i32);
         self.velocity_q8 = [0; 3];
         self.position_x2_q8 = [0; 3];
@@ -118,6 +121,15 @@ impl ZuptIntegrator {
     /// Samples integrated since [`ZuptIntegrator::start`].
     pub const fn samples(&self) -> u32 {
         self.samples
+    }
+
+    /// True when the heading changed by more than 45° over the movement: the rotation from
+    /// the start attitude to the current one, `q ⊗ q₀*`, is about the vertical for a foot
+    /// flat at both ends, and turns by more than 45° when `|z| > tan(22.5°)·|w|`.
+    pub fn turned_over_45_deg(&self) -> bool {
+        let r = self.attitude * self.start_attitude.conjugate();
+        // tan(22.5°) = 0.414 213 56.
+        (r.z as i64).abs() * 100_000_000 > (r.w as i64).abs() * 41_421_356
     }
 
     /// The displacement, with the residual end velocity removed as linear drift.

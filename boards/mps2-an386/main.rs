@@ -137,7 +137,7 @@ fn main() -> ! {
     // unmasking cannot break a critical section.
     unsafe { NVIC::unmask(Irq(TIMER0_IRQ)) };
 
-    let mut pipeline = Pipeline::new(Config { rate, accel, gyro });
+    let mut pipeline = Pipeline::new(Config::new(rate, accel, gyro));
     let mut log = StrideLog::new(rate);
     let mut samples = 0u32;
     loop {
@@ -154,14 +154,16 @@ fn main() -> ! {
                         "gap of {=u32} samples: the stride in progress is dropped",
                         n
                     );
-                    pipeline.gap(n);
+                    if let Some(stride) = pipeline.gap(n) {
+                        log.stride(&stride);
+                    }
                 }
             }
         }
         if TRACE_DONE.load(Ordering::Acquire) && !consumer.ready() {
             timer.stop();
-            if let Some(stride) = pipeline.finish() {
-                log.stride(&stride);
+            for stride in pipeline.finish().iter().flatten() {
+                log.stride(stride);
             }
             log.summary(
                 samples,

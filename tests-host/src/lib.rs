@@ -4,6 +4,7 @@
 
 pub mod csv_trace;
 pub mod datasets;
+pub mod eval;
 pub mod firmware;
 pub mod fixtures;
 pub mod mcap_io;

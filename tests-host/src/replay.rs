@@ -59,24 +59,48 @@ pub fn flag_names(f: StrideFlags) -> Vec<&'static str> {
     if f.has(StrideFlags::FROM_REST) {
         v.push("from_rest");
     }
+    if f.has(StrideFlags::TO_REST) {
+        v.push("to_rest");
+    }
+    if f.has(StrideFlags::TURN) {
+        v.push("turn");
+    }
+    if f.has(StrideFlags::PHASES_GUESSED) {
+        v.push("phases_guessed");
+    }
     v
 }
 
-/// Replays raw counts at `rate` through the core. `t_s(i)` gives the time of sample `i`.
+/// Replays raw counts at `rate` through the core with the default configuration. `t_s(i)`
+/// gives the time of sample `i`.
 pub fn replay_counts(
     samples: &[RawSample],
     rate: SampleRate,
     ranges: Ranges,
     t_s: impl Fn(u32) -> f64,
 ) -> Vec<StrideReport> {
-    let mut p = Pipeline::new(Config {
-        rate,
-        accel: ranges.accel,
-        gyro: ranges.gyro,
-    });
+    let config = Config::new(rate, ranges.accel, ranges.gyro);
+    replay_counts_with(samples, config, t_s)
+}
+
+/// The core's strides for raw counts, in the order it reports them.
+pub fn core_strides(samples: &[RawSample], config: Config) -> Vec<Stride> {
+    let mut p = Pipeline::new(config);
     let mut strides: Vec<Stride> = samples.iter().filter_map(|s| p.process(s)).collect();
-    strides.extend(p.finish());
-    strides.into_iter().map(|s| report(s, &t_s)).collect()
+    strides.extend(p.finish().into_iter().flatten());
+    strides
+}
+
+/// Replays raw counts through the core configured by `config`.
+pub fn replay_counts_with(
+    samples: &[RawSample],
+    config: Config,
+    t_s: impl Fn(u32) -> f64,
+) -> Vec<StrideReport> {
+    core_strides(samples, config)
+        .into_iter()
+        .map(|s| report(s, &t_s))
+        .collect()
 }
 
 /// Replays a trace in physical units: converts to counts at `ranges` (with saturation) first.

@@ -38,19 +38,19 @@ fn runs() -> impl Strategy<Value = Vec<RawSample>> {
 }
 
 fn check(samples: &[RawSample], rate_hz: u32, gaps: &[usize]) {
-    let mut p = Pipeline::new(Config {
-        rate: SampleRate::from_hz(rate_hz).unwrap(),
-        accel: AccelRange::G16,
-        gyro: GyroRange::Dps2000,
-    });
+    let mut p = Pipeline::new(Config::new(
+        SampleRate::from_hz(rate_hz).unwrap(),
+        AccelRange::G16,
+        GyroRange::Dps2000,
+    ));
     let mut strides = Vec::new();
     for (i, s) in samples.iter().enumerate() {
         if gaps.contains(&i) {
-            p.gap(7);
+            strides.extend(p.gap(7));
         }
         strides.extend(p.process(s));
     }
-    strides.extend(p.finish());
+    strides.extend(p.finish().into_iter().flatten());
     for (k, s) in strides.iter().enumerate() {
         assert!(s.start <= s.heel_off && s.heel_off <= s.toe_off, "{s:?}");
         assert!(s.toe_off <= s.heel_strike && s.heel_strike < s.end, "{s:?}");

@@ -5,6 +5,9 @@ use std::process::ExitCode;
 use anyhow::Context;
 use clap::{Parser, Subcommand};
 use gaitclip_host::trace::{Ranges, Trace};
+use gaitclip::phases::PhaseMethod;
+use gaitclip::pipeline::Config;
+use gaitclip_host::eval::{self, Detected};
 use gaitclip_host::{csv_trace, fixtures, mcap_io, replay};
 
 #[derive(Parser)]
@@ -34,12 +37,43 @@ enum Cmd {
         #[arg(long, value_name = "FILE")]
         mcap_out: Option<PathBuf>,
     },
+    /// Score stride detection, gait events, phases and stance against the ground truth of
+    /// dataset folders (`../shared/datasets/<name>`); prints Markdown tables.
+    Eval {
+        /// Dataset folders.
+        #[arg(required = true)]
+        datasets: Vec<PathBuf>,
+        /// Also run each trace after this many random rotations (a clip mounted any way).
+        #[arg(long, default_value_t = 0)]
+        rotate: usize,
+        /// Seed of the rotations.
+        #[arg(long, default_value_t = 1)]
+        seed: u64,
+        /// Phase splitter: Huang's major peak-valley pairs or the augmented version.
+        #[arg(long, value_enum, default_value_t = PhasesArg::Augmented)]
+        phases: PhasesArg,
+    },
     /// Regenerate the simulated fixtures (traces with ground truth) into a folder.
     Simulate {
         /// Output folder.
         #[arg(long, default_value = "../fixtures")]
         out: PathBuf,
     },
+}
+
+#[derive(Clone, Copy, clap::ValueEnum)]
+enum PhasesArg {
+    MajorPairs,
+    Augmented,
+}
+
+impl From<PhasesArg> for PhaseMethod {
+    fn from(p: PhasesArg) -> Self {
+        match p {
+            PhasesArg::MajorPairs => PhaseMethod::MajorPairs,
+            PhasesArg::Augmented => PhaseMethod::Augmented,
+        }
+    }
 }
 
 fn main() -> ExitCode {
@@ -100,6 +134,31 @@ fn run(cli: Cli) -> anyhow::Result<()> {
                 mcap_io::write(std::io::BufWriter::new(f), &t.samples, &strides)?;
                 eprintln!("wrote {}", out.display());
             }
+        }
+        Cmd::Eval {
+            datasets,
+            rotate,
+            seed,
+            phases,
+        } => {
+            let detector = |t: &Trace, r: Ranges| -> anyhow::Result<Vec<Detected>> {
+                let rate = t
+                    .sample_rate()
+                    .ok_or(replay::ReplayError::Rate(t.rate_hz))?;
+                let mut config = Config::new(rate, r.accel, r.gyro);
+                config.phases = phases.into();
+                let counts: Vec<_> = t.samples.iter().map(|s| r.to_counts(s)).collect();
+                Ok(replay::core_strides(&counts, config)
+                    .iter()
+                    .map(Detected::from)
+                    .collect())
+            };
+            let mut results = Vec::new();
+            for dir in &datasets {
+                let d = eval::load(dir)?;
+                results.push(eval::evaluate(&d, &detector, rotate, seed)?);
+            }
+            print!("{}", eval::table(&results));
         }
         Cmd::Simulate { out } => {
             fixtures::write_all(&out)?;

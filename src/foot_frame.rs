@@ -1,0 +1,316 @@
+//! The foot frame, found from the data: which way is up, which way is forward.
+//!
+//! A clip is mounted however its user mounts it, but Huang's stance test and phase splitter
+//! read the *vertical* and *sagittal* (forward) acceleration of the foot. The estimator works
+//! them out from two facts of walking:
+//!
+//! - **At rest the accelerometer reads gravity alone.** The mean specific force of each rest
+//!   period (found by the orientation-free [`crate::rest`] test) is the up axis.
+//! - **In a step the foot pitches about its medio-lateral axis.** The angular rate of a
+//!   movement is dominated by that axis: the principal eigenvector of `Σ ω ωᵀ` over the
+//!   movement, projected on the horizontal plane. Its sign comes from the order of the
+//!   rotations: the foot first rolls onto its toes (toe down) and pitches toe up through the
+//!   swing, so the first moment `Σ (k − k̄) ω` points along *minus* the left axis when the
+//!   rotation is measured about *left* (toe-down is a positive rotation about left when x is
+//!   forward and z up).
+//!
+//! Forward is then `left × up`. Estimates are smoothed over rest periods and strides, and
+//! re-started when a rest period's gravity direction is more than [`REMOUNT_DEG`] away from
+//! the current up (the clip was moved on the shoe).
+//!
+//! The once-per-movement 3×3 work is `f32` with `nalgebra` (Jacobi eigen-decomposition);
+//! IEEE arithmetic and `libm` make it bit-identical on every target. The per-sample rotation
+//! ([`FootFrame::apply`]) is integer.
+
+use nalgebra::{Matrix3, SymmetricEigen, Vector3};
+
+use crate::rate::SampleRate;
+use crate::sample::{AccelRange, RawSample};
+
+/// A rest period whose gravity direction is further than this from the current up axis
+/// means the clip was moved: the frame starts again.
+pub const REMOUNT_DEG: u32 = 25;
+/// Movements used to learn the medio-lateral axis: longer than this (a step, not a wobble)…
+pub const AXIS_MIN_MOVEMENT_MS: u32 = 250;
+/// …and shorter than this (walking, not fiddling with the shoe).
+pub const AXIS_MAX_MOVEMENT_MS: u32 = 2500;
+/// Foot-frame accelerations are in units of g/[`FOOT_LSB_PER_G`] whatever the sensor's
+/// range: the counts of the ±16 g range.
+pub const FOOT_LSB_PER_G: i32 = 2048;
+
+/// cos(REMOUNT_DEG).
+const COS_REMOUNT: f32 = 0.906_307_8;
+/// Weight of a new rest period in the smoothed up axis and gravity.
+const UP_SMOOTHING: f32 = 0.125;
+/// Weight kept by the medio-lateral axis sum at each new movement.
+const AXIS_MEMORY: f32 = 0.875;
+/// Rest sums are halved beyond this many samples (standing for hours stays bounded).
+const REST_SUM_HALVING_AT: u32 = 1 << 16;
+
+/// Rotation from sensor counts into the foot frame, Q14 with the range scaling folded in.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct FootFrame {
+    /// Rows: forward, left, up; each `unit · 2¹⁴ · FOOT_LSB_PER_G / lsb_per_g`.
+    rows: [[i32; 3]; 3],
+    /// Gravity in foot units (g/2048), as measured at rest.
+    gravity: i32,
+    /// The forward axis was learnt from movements (not a placeholder perpendicular to up).
+    heading_known: bool,
+}
+
+impl FootFrame {
+    /// Specific force `accel` (counts) in the foot frame, gravity removed from the vertical:
+    /// `[forward, left, up − g]` in g/2048, saturated to ±32 767 (±16 g).
+    ///
+    /// Error: the Q14 matrix is within 2⁻¹⁵ per entry of the `f32` rotation, so the result
+    /// is within 1 unit (0.5 mg) plus rounding of the exact rotation for any `i16` input.
+    pub fn apply(&self, accel: [i16; 3]) -> [i16; 3] {
+        let mut out = [0i16; 3];
+        for (o, row) in out.iter_mut().zip(self.rows.iter()) {
+            // |row| ≤ 2¹⁴·√(Σ) per axis and |a| ≤ 2¹⁵: each product < 2²⁹, the sum < 2³¹.
+            let dot: i64 = row
+                .iter()
+                .zip(accel.iter())
+                .map(|(&r, &a)| r as i64 * a as i64)
+                .sum();
+            *o = ((dot + (1 << 13)) >> 14).clamp(-32_767, 32_767) as i16;
+        }
+        out[2] = (out[2] as i32 - self.gravity).clamp(-32_767, 32_767) as i16;
+        out
+    }
+
+    /// The rotation as rows of `f32` unit vectors (forward, left, up), for logs and tests.
+    pub fn axes(&self, accel: AccelRange) -> [[f32; 3]; 3] {
+        let scale = (1u32 << 14) as f32 * FOOT_LSB_PER_G as f32 / accel.lsb_per_g() as f32;
+        self.rows.map(|r| r.map(|v| v as f32 / scale))
+    }
+
+    /// Gravity measured at rest, in g/2048.
+    pub const fn gravity(&self) -> i32 {
+        self.gravity
+    }
+
+    /// Whether the forward axis has been learnt from movements yet.
+    pub const fn heading_known(&self) -> bool {
+        self.heading_known
+    }
+}
+
+/// Learns the foot frame from rest periods and movements.
+#[derive(Clone, Debug)]
+pub struct FootFrameEstimator {
+    accel: AccelRange,
+    axis_min: u32,
+    axis_max: u32,
+    frame: Option<FootFrame>,
+    up: [f32; 3],
+    gravity_counts: f32,
+    left_sum: [f32; 3],
+    heading_known: bool,
+    was_rest: bool,
+    rest_accel: [i64; 3],
+    rest_gyro: [i64; 3],
+    rest_n: u32,
+    gyro_bias: [i32; 3],
+    /// Σ ω ωᵀ over the movement: xx, yy, zz, xy, xz, yz (counts²).
+    cov: [i64; 6],
+    sum_w: [i64; 3],
+    moment: [i64; 3],
+    move_n: u32,
+}
+
+impl FootFrameEstimator {
+    /// An estimator that knows nothing yet.
+    pub const fn new(rate: SampleRate, accel: AccelRange) -> Self {
+        FootFrameEstimator {
+            accel,
+            axis_min: rate.samples_in_ms(AXIS_MIN_MOVEMENT_MS),
+            axis_max: rate.samples_in_ms(AXIS_MAX_MOVEMENT_MS),
+            frame: None,
+            up: [0.0; 3],
+            gravity_counts: 0.0,
+            left_sum: [0.0; 3],
+            heading_known: false,
+            was_rest: false,
+            rest_accel: [0; 3],
+            rest_gyro: [0; 3],
+            rest_n: 0,
+            gyro_bias: [0; 3],
+            cov: [0; 6],
+            sum_w: [0; 3],
+            moment: [0; 3],
+            move_n: 0,
+        }
+    }
+
+    /// The current frame; `None` until the first rest period has ended.
+    pub const fn frame(&self) -> Option<FootFrame> {
+        self.frame
+    }
+
+    /// Feeds one raw sample and the rest decision about it.
+    pub fn process(&mut self, s: &RawSample, rest: bool) {
+        match (self.was_rest, rest) {
+            (false, true) => {
+                self.end_movement();
+                self.rest_accel = [0; 3];
+                self.rest_gyro = [0; 3];
+                self.rest_n = 0;
+                self.accumulate_rest(s);
+            }
+            (true, true) => self.accumulate_rest(s),
+            (true, false) => {
+                self.end_rest();
+                self.cov = [0; 6];
+                self.sum_w = [0; 3];
+                self.moment = [0; 3];
+                self.move_n = 0;
+                self.accumulate_movement(s);
+            }
+            (false, false) => self.accumulate_movement(s),
+        }
+        self.was_rest = rest;
+    }
+
+    fn accumulate_rest(&mut self, s: &RawSample) {
+        if self.rest_n >= REST_SUM_HALVING_AT {
+            self.rest_accel = self.rest_accel.map(|v| v / 2);
+            self.rest_gyro = self.rest_gyro.map(|v| v / 2);
+            self.rest_n /= 2;
+        }
+        for i in 0..3 {
+            self.rest_accel[i] += s.accel[i] as i64;
+            self.rest_gyro[i] += s.gyro[i] as i64;
+        }
+        self.rest_n += 1;
+    }
+
+    fn accumulate_movement(&mut self, s: &RawSample) {
+        if self.move_n >= self.axis_max {
+            return;
+        }
+        let w = [0, 1, 2].map(|i| s.gyro[i] as i64 - self.gyro_bias[i] as i64);
+        // |w| < 2¹⁷, products < 2³⁴, sums over ≤ 25 000 samples < 2⁴⁹.
+        let products = [
+            w[0] * w[0],
+            w[1] * w[1],
+            w[2] * w[2],
+            w[0] * w[1],
+            w[0] * w[2],
+            w[1] * w[2],
+        ];
+        for (c, p) in self.cov.iter_mut().zip(products) {
+            *c += p;
+        }
+        for i in 0..3 {
+            self.sum_w[i] += w[i];
+            self.moment[i] += w[i] * self.move_n as i64;
+        }
+        self.move_n += 1;
+    }
+
+    fn end_rest(&mut self) {
+        if self.rest_n == 0 {
+            return;
+        }
+        let n = self.rest_n as f32;
+        let mean = self.rest_accel.map(|v| v as f32 / n);
+        self.gyro_bias = [0, 1, 2].map(|i| {
+            let n = self.rest_n as i64;
+            ((self.rest_gyro[i] + n / 2).div_euclid(n)) as i32
+        });
+        let m = Vector3::from(mean);
+        let g = m.norm();
+        if !(g > 0.0) {
+            return;
+        }
+        let u = m / g;
+        let up = Vector3::from(self.up);
+        if self.frame.is_none() || u.dot(&up) < COS_REMOUNT {
+            self.up = u.into();
+            self.gravity_counts = g;
+            self.left_sum = [0.0; 3];
+            self.heading_known = false;
+        } else {
+            let blended = up * (1.0 - UP_SMOOTHING) + u * UP_SMOOTHING;
+            self.up = blended.normalize().into();
+            self.gravity_counts = self.gravity_counts * (1.0 - UP_SMOOTHING) + g * UP_SMOOTHING;
+        }
+        self.rebuild();
+    }
+
+    fn end_movement(&mut self) {
+        if self.frame.is_none() || self.move_n < self.axis_min || self.move_n >= self.axis_max
+        {
+            return;
+        }
+        let c = self.cov.map(|v| v as f32);
+        let cov = Matrix3::new(c[0], c[3], c[4], c[3], c[1], c[5], c[4], c[5], c[2]);
+        let eig = SymmetricEigen::new(cov);
+        let mut best = 0;
+        for i in 1..3 {
+            if eig.eigenvalues[i] > eig.eigenvalues[best] {
+                best = i;
+            }
+        }
+        let axis: Vector3<f32> = eig.eigenvectors.column(best).into();
+        let up = Vector3::from(self.up);
+        let horizontal = axis - up * axis.dot(&up);
+        // A rotation mostly about the vertical is a turn on the spot, not a step.
+        if horizontal.norm() < 0.7 {
+            return;
+        }
+        let n = self.move_n as f32;
+        let centred = [0, 1, 2].map(|i| {
+            self.moment[i] as f32 - self.sum_w[i] as f32 * (n - 1.0) * 0.5
+        });
+        let sign = if horizontal.dot(&Vector3::from(centred)) < 0.0 {
+            1.0
+        } else {
+            -1.0
+        };
+        let left = horizontal.normalize() * sign;
+        let sum = Vector3::from(self.left_sum) * AXIS_MEMORY + left;
+        self.left_sum = sum.into();
+        self.heading_known = true;
+        self.rebuild();
+    }
+
+    fn rebuild(&mut self) {
+        let up = Vector3::from(self.up);
+        let mut left = Vector3::from(self.left_sum);
+        left -= up * left.dot(&up);
+        if left.norm() < 1e-3 {
+            // No heading yet: any horizontal axis, from the sensor axis least aligned with up.
+            let mut k = 0;
+            for i in 1..3 {
+                if self.up[i].abs() < self.up[k].abs() {
+                    k = i;
+                }
+            }
+            let mut e = Vector3::zeros();
+            e[k] = 1.0;
+            left = e - up * e.dot(&up);
+        }
+        let left = left.normalize();
+        let forward = left.cross(&up);
+        let scale = (1u32 << 14) as f32 * FOOT_LSB_PER_G as f32 / self.accel.lsb_per_g() as f32;
+        let row = |v: Vector3<f32>| [0, 1, 2].map(|i| libm_round(v[i] * scale));
+        let gravity = libm_round(self.gravity_counts * FOOT_LSB_PER_G as f32
+            / self.accel.lsb_per_g() as f32);
+        self.frame = Some(FootFrame {
+            rows: [row(forward), row(left), row(up)],
+            gravity,
+            heading_known: self.heading_known,
+        });
+    }
+}
+
+/// Round to nearest, for values well inside `i32` (matrix entries and gravity).
+fn libm_round(v: f32) -> i32 {
+    if v >= 0.0 {
+        (v + 0.5) as i32
+    } else {
+        (v - 0.5) as i32
+    }
+}

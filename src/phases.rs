@@ -1,0 +1,321 @@
+//! Phase splitter after Huang et al. 2022, §2.3.2: where the push-off ends (toe-off) and
+//! where the heel strikes, inside one movement between two stances.
+//!
+//! Input: the movement (heel-off to foot-flat) as foot-frame vertical (gravity removed) and
+//! sagittal acceleration, mean-filtered, in g/2048.
+//!
+//! 1. **Peaks and valleys** of both signals: local maxima above [`MIN_EXTREME_MG`] and local
+//!    minima below its negative (smaller wiggles are sensor noise).
+//! 2. **Two clusters** (Algorithm 1): 1-D k-means, k = 2, on the sample positions of all
+//!    extremes, centres started at the movement's first and last sample, at most 50
+//!    iterations. The left cluster holds the push-off's force changes, the right one the
+//!    heel-strike's.
+//! 3. **Major peak-valley pair** per cluster and signal: each peak is paired with the
+//!    nearest valley before it ("found backward", as the paper says; searching both ways
+//!    put the heel-strike 10 ms nearer on `gaitmap_walk` but 10 ms further on
+//!    `ipol_gait_events`, and swing IoU fell from 0.844 to 0.822 overall); (1) a zero crossing lies between them
+//!    (always, since peaks are positive and valleys negative), (2) the major pair has the
+//!    largest peak-to-valley magnitude, (3) a pair whose magnitude exceeds half the major's
+//!    and whose peak lies within [`MERGE_MS`] of the major valley is merged into it (the
+//!    merged pair keeps the higher peak and the lower valley).
+//! 4. **Boundaries.** Toe-off = mean of the sagittal major peak and the vertical major
+//!    valley in the left cluster; heel-strike = mean of the sagittal and vertical major peaks
+//!    in the right cluster.
+//! 5. **Augmented** ([`PhaseMethod::Augmented`]): two more references per boundary, the zero
+//!    crossings of the derivatives nearest each major pair (downward crossings, i.e. peaks,
+//!    except the vertical push-off reference, an upward crossing); each reference more than
+//!    3σ from the mean of the others (leave-one-out) is dropped and the rest averaged.
+//!
+//! Integer throughout: positions are sample offsets, the k-means centres are kept ×16, the
+//! outlier test is done on squared integers without a root.
+
+use heapless::Vec;
+
+/// Extremes smaller than this (mg) are ignored.
+pub const MIN_EXTREME_MG: i32 = 100;
+/// Condition (3): a second pair's peak within this many ms of the major valley merges
+/// (5 samples at Huang's 100 Hz).
+pub const MERGE_MS: u32 = 50;
+/// At most this many extremes per movement are considered; later ones are ignored.
+pub const MAX_EXTREMES: usize = 256;
+/// Iteration cap of the k-means (Algorithm 1).
+pub const KMEANS_MAX_ITERATIONS: u32 = 50;
+
+/// Which version of Huang's splitter to run.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum PhaseMethod {
+    /// Major peak-valley pairs of the two signals, two references per boundary.
+    MajorPairs,
+    /// Plus derivative zero crossings and leave-one-out 3σ rejection, four references.
+    Augmented,
+}
+
+/// The two inner boundaries of a movement, as offsets from its first sample.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct PhaseSplit {
+    /// Push-off/swing boundary.
+    pub toe_off: u32,
+    /// Swing/heel-strike boundary.
+    pub heel_strike: u32,
+    /// Both boundaries came from major pairs; `false` means they are cluster centres.
+    pub found: bool,
+}
+
+#[derive(Clone, Copy, Debug)]
+struct Extreme {
+    at: u32,
+    value: i32,
+    axis: u8,
+    peak: bool,
+}
+
+#[derive(Clone, Copy, Debug)]
+struct Pair {
+    peak: Extreme,
+    valley: Extreme,
+}
+
+impl Pair {
+    fn magnitude(&self) -> i32 {
+        self.peak.value - self.valley.value
+    }
+
+    /// Centre ×2, for the nearest-crossing search.
+    fn centre_x2(&self) -> u32 {
+        self.peak.at + self.valley.at
+    }
+}
+
+/// Axis numbers in the input pairs.
+const VERTICAL: u8 = 0;
+const SAGITTAL: u8 = 1;
+
+/// Splits one movement. `movement[i] = [vertical, sagittal]` (g/2048); `merge_samples` is
+/// [`MERGE_MS`] at the sample rate. Never panics; a movement of fewer than 3 samples or
+/// without extremes gives its quarter and three-quarter points with `found = false`.
+pub fn split(movement: &[[i16; 2]], method: PhaseMethod, merge_samples: u32) -> PhaseSplit {
+    let len = movement.len() as u32;
+    let fallback = PhaseSplit {
+        toe_off: len / 4,
+        heel_strike: (3 * len / 4).min(len.saturating_sub(1)),
+        found: false,
+    };
+    if len < 3 {
+        return fallback;
+    }
+    let extremes = find_extremes(movement);
+    if extremes.is_empty() {
+        return fallback;
+    }
+    let (c_left, c_right) = kmeans(&extremes, len);
+    let in_left = |e: &Extreme| (e.at * 16).abs_diff(c_left) < (e.at * 16).abs_diff(c_right);
+    let major = |axis: u8, left: bool| {
+        major_pair(
+            extremes
+                .iter()
+                .filter(|e| e.axis == axis && in_left(e) == left),
+            merge_samples,
+        )
+    };
+    let (sag_l, vert_l) = (major(SAGITTAL, true), major(VERTICAL, true));
+    let (sag_r, vert_r) = (major(SAGITTAL, false), major(VERTICAL, false));
+
+    let mut to_refs: Vec<u32, 4> = Vec::new();
+    let mut hs_refs: Vec<u32, 4> = Vec::new();
+    if let Some(p) = sag_l {
+        let _ = to_refs.push(p.peak.at);
+    }
+    if let Some(p) = vert_l {
+        let _ = to_refs.push(p.valley.at);
+    }
+    if let Some(p) = sag_r {
+        let _ = hs_refs.push(p.peak.at);
+    }
+    if let Some(p) = vert_r {
+        let _ = hs_refs.push(p.peak.at);
+    }
+    if method == PhaseMethod::Augmented {
+        let crossing = |pair: Option<Pair>, axis: u8, downward: bool| {
+            pair.and_then(|p| nearest_derivative_crossing(movement, axis, downward, p))
+        };
+        for r in [
+            crossing(sag_l, SAGITTAL, true),
+            crossing(vert_l, VERTICAL, false),
+        ]
+        .into_iter()
+        .flatten()
+        {
+            let _ = to_refs.push(r);
+        }
+        for r in [
+            crossing(sag_r, SAGITTAL, true),
+            crossing(vert_r, VERTICAL, true),
+        ]
+        .into_iter()
+        .flatten()
+        {
+            let _ = hs_refs.push(r);
+        }
+    }
+    let to = fuse(&to_refs);
+    let hs = fuse(&hs_refs);
+    match (to, hs) {
+        (Some(to), Some(hs)) if to < hs && hs < len => PhaseSplit {
+            toe_off: to,
+            heel_strike: hs,
+            found: true,
+        },
+        _ => PhaseSplit {
+            toe_off: (c_left / 16).min(len - 1),
+            heel_strike: (c_right / 16).min(len - 1),
+            found: false,
+        },
+    }
+}
+
+fn find_extremes(movement: &[[i16; 2]]) -> Vec<Extreme, MAX_EXTREMES> {
+    let min = MIN_EXTREME_MG * crate::foot_frame::FOOT_LSB_PER_G / 1000;
+    let mut out = Vec::new();
+    for (i, w) in movement.windows(3).enumerate() {
+        for axis in [VERTICAL, SAGITTAL] {
+            let a = axis as usize;
+            let (prev, x, next) = (w[0][a] as i32, w[1][a] as i32, w[2][a] as i32);
+            let peak = x > prev && x >= next && x > min;
+            let valley = x < prev && x <= next && x < -min;
+            if peak || valley {
+                let _ = out.push(Extreme {
+                    at: i as u32 + 1,
+                    value: x,
+                    axis,
+                    peak,
+                });
+            }
+        }
+    }
+    out
+}
+
+/// Algorithm 1: returns the left and right centres, ×16.
+fn kmeans(extremes: &[Extreme], len: u32) -> (u32, u32) {
+    let mut c = [0u32, (len - 1) * 16];
+    for _ in 0..KMEANS_MAX_ITERATIONS {
+        let mut sum = [0u64; 2];
+        let mut count = [0u64; 2];
+        for e in extremes {
+            let x = e.at * 16;
+            let k = if x.abs_diff(c[0]) < x.abs_diff(c[1]) {
+                0
+            } else {
+                1
+            };
+            sum[k] += x as u64;
+            count[k] += 1;
+        }
+        let mut next = c;
+        for k in 0..2 {
+            if count[k] > 0 {
+                next[k] = ((sum[k] + count[k] / 2) / count[k]) as u32;
+            }
+        }
+        if next == c {
+            break;
+        }
+        c = next;
+    }
+    (c[0], c[1])
+}
+
+fn major_pair<'a>(extremes: impl Iterator<Item = &'a Extreme> + Clone, merge: u32) -> Option<Pair> {
+    let pairs = extremes.clone().filter(|e| e.peak).filter_map(move |p| {
+        extremes
+            .clone()
+            .filter(|v| !v.peak && v.at < p.at)
+            .min_by_key(|v| v.at.abs_diff(p.at))
+            .map(|v| Pair {
+                peak: *p,
+                valley: *v,
+            })
+    });
+    let mut major: Option<Pair> = None;
+    for pair in pairs.clone() {
+        if major.is_none_or(|m| pair.magnitude() > m.magnitude()) {
+            major = Some(pair);
+        }
+    }
+    let mut major = major?;
+    let first = major;
+    for pair in pairs {
+        let close = pair.peak.at.abs_diff(first.valley.at) <= merge;
+        let distinct = pair.peak.at != first.peak.at;
+        if distinct && close && 2 * pair.magnitude() > first.magnitude() {
+            if pair.peak.value > major.peak.value {
+                major.peak = pair.peak;
+            }
+            if pair.valley.value < major.valley.value {
+                major.valley = pair.valley;
+            }
+        }
+    }
+    Some(major)
+}
+
+/// The sample where the derivative of `axis` crosses zero downward (a peak) or upward
+/// (a valley), nearest the centre of `pair`. The derivative is the central difference.
+fn nearest_derivative_crossing(
+    movement: &[[i16; 2]],
+    axis: u8,
+    downward: bool,
+    pair: Pair,
+) -> Option<u32> {
+    let a = axis as usize;
+    let d = |i: usize| movement[i + 1][a] as i32 - movement[i - 1][a] as i32;
+    let centre_x2 = pair.centre_x2();
+    let mut best: Option<u32> = None;
+    for i in 2..movement.len().saturating_sub(1) {
+        let (before, now) = (d(i - 1), d(i));
+        let crossed = if downward {
+            before > 0 && now <= 0
+        } else {
+            before < 0 && now >= 0
+        };
+        if crossed {
+            let at = i as u32;
+            if best.is_none_or(|b| (2 * at).abs_diff(centre_x2) < (2 * b).abs_diff(centre_x2)) {
+                best = Some(at);
+            }
+        }
+    }
+    best
+}
+
+/// Leave-one-out 3σ rejection (with three or more references), then the mean, rounded.
+fn fuse(refs: &[u32]) -> Option<u32> {
+    if refs.is_empty() {
+        return None;
+    }
+    let mut kept_sum = 0u64;
+    let mut kept = 0u64;
+    for (i, &r) in refs.iter().enumerate() {
+        let others = refs.len() as i64 - 1;
+        let outlier = others >= 2 && {
+            let (mut s, mut q) = (0i64, 0i64);
+            for (j, &o) in refs.iter().enumerate() {
+                if j != i {
+                    s += o as i64;
+                    q += o as i64 * o as i64;
+                }
+            }
+            // (r − mean)² > 9σ² ⇔ (m·r − s)² > 9·(m·q − s²) for m others (population σ).
+            let dev = others * r as i64 - s;
+            dev * dev > 9 * (others * q - s * s)
+        };
+        if !outlier {
+            kept_sum += r as u64;
+            kept += 1;
+        }
+    }
+    if kept == 0 {
+        return None;
+    }
+    Some(((kept_sum + kept / 2) / kept) as u32)
+}

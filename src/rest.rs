@@ -1,0 +1,140 @@
+//! Rest detector, orientation-free: is the clip still?
+//!
+//! The foot frame ([`crate::foot_frame`]) needs rest periods before it knows which way is
+//! up, so this test cannot use the frame. Over a sliding window of `W` samples (≈ 50 ms) the
+//! clip is at rest when both
+//! - the total variance of the (mean-filtered) specific force, `Σ_axes var(a)`, is under
+//!   [`ACCEL_STD_MAX_MMPS2`]², and
+//! - the mean angular-rate energy `mean(|ω|²)` is under [`GYRO_RMS_MAX_MRADPS`]²,
+//!
+//! the accelerometer and gyroscope halves of the SHOE detector (Skog et al. 2010). Neither
+//! statistic depends on how the clip is mounted. Thresholds are set in physical units and
+//! converted to counts for the configured ranges; the window follows the sample rate.
+
+use crate::rate::SampleRate;
+use crate::sample::{AccelRange, GyroRange};
+
+/// Window length in milliseconds (5 samples at 100 Hz, as SHOE uses).
+pub const WINDOW_MS: u32 = 50;
+/// Capacity of the window ring, a power of two ≥ the longest window (50 ms at 1 kHz).
+pub const WINDOW_CAPACITY: usize = 64;
+/// Stance: standard deviation of the specific force (all axes together) under 0.6 m/s².
+/// Walking swing stays above 3 m/s²; standing with a wobble stays under 0.3 m/s².
+pub const ACCEL_STD_MAX_MMPS2: u32 = 600;
+/// Stance: RMS angular rate under 0.7 rad/s (40 °/s). Mid-swing exceeds 5 rad/s; a flat
+/// foot that rolls over stays under 0.5 rad/s on the recordings in `../shared/datasets`.
+pub const GYRO_RMS_MAX_MRADPS: u32 = 700;
+
+/// Thresholds of the detector, in counts of the configured ranges.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct RestThresholds {
+    /// Window length in samples (3..=63).
+    pub window: u32,
+    /// Variance threshold, counts².
+    pub accel_var_counts2: i64,
+    /// Energy threshold, counts².
+    pub gyro_energy_counts2: i64,
+}
+
+impl RestThresholds {
+    /// Thresholds for a sample rate and sensor ranges.
+    pub const fn new(rate: SampleRate, accel: AccelRange, gyro: GyroRange) -> Self {
+        let window = rate.samples_in_ms(WINDOW_MS);
+        let window = if window < 3 {
+            3
+        } else if window > WINDOW_CAPACITY as u32 - 1 {
+            WINDOW_CAPACITY as u32 - 1
+        } else {
+            window
+        };
+        // m/s² → counts: · lsb_per_g / 9.80665.
+        let a = ACCEL_STD_MAX_MMPS2 as i64 * accel.lsb_per_g() as i64 / 9807;
+        // rad/s → counts: · (180/π) · lsb_per_dps (lsb10 / 10); 18/(π·1000) = 1800/314159.
+        let g = GYRO_RMS_MAX_MRADPS as i64 * gyro.lsb_per_dps_x10() as i64 * 1800 / 314_159;
+        RestThresholds {
+            window,
+            accel_var_counts2: a * a,
+            gyro_energy_counts2: g * g,
+        }
+    }
+}
+
+/// Streaming, orientation-free rest detector.
+#[derive(Clone, Debug)]
+pub struct RestDetector {
+    thresholds: RestThresholds,
+    accel: [[i16; 3]; WINDOW_CAPACITY],
+    accel_sq: [i64; WINDOW_CAPACITY],
+    gyro_sq: [i64; WINDOW_CAPACITY],
+    sum_a: [i64; 3],
+    sum_a_sq: i64,
+    sum_g_sq: i64,
+    head: usize,
+    seen: u32,
+}
+
+impl RestDetector {
+    /// A detector with no history.
+    pub const fn new(thresholds: RestThresholds) -> Self {
+        RestDetector {
+            thresholds,
+            accel: [[0; 3]; WINDOW_CAPACITY],
+            accel_sq: [0; WINDOW_CAPACITY],
+            gyro_sq: [0; WINDOW_CAPACITY],
+            sum_a: [0; 3],
+            sum_a_sq: 0,
+            sum_g_sq: 0,
+            head: 0,
+            seen: 0,
+        }
+    }
+
+    /// Forgets the history (after a gap in the samples).
+    pub fn reset(&mut self) {
+        *self = RestDetector::new(self.thresholds);
+    }
+
+    /// Samples of delay between the newest input and the centre of the window the answer
+    /// describes.
+    pub const fn delay(&self) -> u32 {
+        self.thresholds.window / 2
+    }
+
+    /// Pushes one filtered sample; returns `Some(rest)` for the window ending here, `None`
+    /// until the window is full.
+    pub fn process(&mut self, accel: [i16; 3], gyro: [i16; 3]) -> Option<bool> {
+        let w = self.thresholds.window as usize;
+        let slot = self.head & (WINDOW_CAPACITY - 1);
+        let leaving = (self.head + WINDOW_CAPACITY - w) & (WINDOW_CAPACITY - 1);
+        let a_sq: i64 = accel.iter().map(|&v| v as i64 * v as i64).sum();
+        let g_sq: i64 = gyro.iter().map(|&v| v as i64 * v as i64).sum();
+        self.accel[slot] = accel;
+        self.accel_sq[slot] = a_sq;
+        self.gyro_sq[slot] = g_sq;
+        for (s, &v) in self.sum_a.iter_mut().zip(accel.iter()) {
+            *s += v as i64;
+        }
+        self.sum_a_sq += a_sq;
+        self.sum_g_sq += g_sq;
+        if self.seen as usize >= w {
+            for (s, &v) in self.sum_a.iter_mut().zip(self.accel[leaving].iter()) {
+                *s -= v as i64;
+            }
+            self.sum_a_sq -= self.accel_sq[leaving];
+            self.sum_g_sq -= self.gyro_sq[leaving];
+        } else {
+            self.seen += 1;
+        }
+        self.head = (self.head + 1) & (WINDOW_CAPACITY - 1);
+        if (self.seen as usize) < w {
+            return None;
+        }
+        let w = w as i64;
+        // W²·var_total = W·Σ|a|² − |Σa|²; both terms < 2^44 for W < 64 and i16 inputs.
+        let sum_sq_of_sum: i64 = self.sum_a.iter().map(|&s| s * s).sum();
+        let var_w2 = w * self.sum_a_sq - sum_sq_of_sum;
+        let still_accel = var_w2 < self.thresholds.accel_var_counts2 * w * w;
+        let still_gyro = self.sum_g_sq < self.thresholds.gyro_energy_counts2 * w;
+        Some(still_accel && still_gyro)
+    }
+}

@@ -1,0 +1,711 @@
+//! `gaitclip eval`: strides, gait events, phases and stance against the ground truth of the
+//! recordings in `../shared/datasets`.
+//!
+//! **Matching.** A detected stride is its movement, heel-off to foot-flat. A reference stride
+//! is the interval its dataset defines (`gaitmap_walk`: mid-stance to mid-stance;
+//! `pyshoe_vicon`: end of stance to end of stance; `ipol_gait_events`: the footstep, toe-off
+//! to heel-strike). Each contains the foot's one movement, so a detection matches a
+//! reference when their overlap is at least half the shorter of the two; pairs are taken
+//! greedily by overlap, one to one. Only detections overlapping the labelled part of a
+//! recording count (from the first to the last reference stride; `ipol_gait_events`: its
+//! walk bounds). Flagged references (first/last strides, turns, shuffles, U-turn steps) and
+//! the detections matched to them count neither as found nor as missed nor as extra.
+//!
+//! **Events.** Toe-off and heel-strike errors are detected minus reference, over clean
+//! matched strides, reported as the median and 95th percentile of their absolute value.
+//!
+//! **Phases** (Huang eq. 7–13). Swing is toe-off → heel-strike; contact is the previous
+//! heel-strike → toe-off (heel-strike phase, stance and push-off together, which is what the
+//! labels bound). A detected phase is a true positive when its IoU with the reference phase
+//! of the matched stride is at least 0.5; the IoU column is the mean over true positives.
+//!
+//! **Stance** (`pyshoe_vicon`): sample-wise F1 of "not inside a detected movement" against
+//! the Vicon stance label, over the labelled part of each trial.
+
+use std::collections::BTreeMap;
+use std::fmt::Write as _;
+use std::path::{Path, PathBuf};
+
+use anyhow::{bail, Context, Result};
+use rand::{Rng, SeedableRng};
+use rand_chacha::ChaCha8Rng;
+use serde::Deserialize;
+
+use crate::csv_trace;
+use crate::trace::{ImuSample, Ranges, Trace};
+
+/// One detected stride, in sample indices of its trial.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Detected {
+    /// Start of the stance before the movement.
+    pub start: u32,
+    /// Heel-off.
+    pub heel_off: u32,
+    /// Toe-off.
+    pub toe_off: u32,
+    /// Heel-strike.
+    pub heel_strike: u32,
+    /// Foot-flat (end).
+    pub end: u32,
+}
+
+impl From<&gaitclip::stride::Stride> for Detected {
+    fn from(s: &gaitclip::stride::Stride) -> Self {
+        Detected {
+            start: s.start,
+            heel_off: s.heel_off,
+            toe_off: s.toe_off,
+            heel_strike: s.heel_strike,
+            end: s.end,
+        }
+    }
+}
+
+/// One reference stride.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Reference {
+    /// Interval that contains the stride's movement.
+    pub start: u32,
+    /// End of that interval.
+    pub end: u32,
+    /// Not clean straight walking: neither counted nor missed.
+    pub flagged: bool,
+    /// Toe-off, where labelled.
+    pub toe_off: Option<u32>,
+    /// Heel-strike ending the swing, where labelled.
+    pub heel_strike: Option<u32>,
+    /// Heel-strike that began the stride's ground contact, where labelled.
+    pub prev_heel_strike: Option<u32>,
+}
+
+/// One recording and its ground truth.
+#[derive(Clone, Debug)]
+pub struct Trial {
+    /// Name as the dataset gives it.
+    pub name: String,
+    /// The trial's CSV.
+    pub csv: PathBuf,
+    /// Reference strides.
+    pub references: Vec<Reference>,
+    /// Labelled part of the recording, samples `[from, to)`.
+    pub span: (u32, u32),
+    /// Per-sample stance label, where the dataset has one.
+    pub stance: Option<Vec<bool>>,
+}
+
+/// A dataset folder.
+#[derive(Clone, Debug)]
+pub struct Dataset {
+    /// Folder name (`gaitmap_walk`, …).
+    pub name: String,
+    /// Nominal sample rate, Hz.
+    pub rate_hz: f64,
+    /// Its trials.
+    pub trials: Vec<Trial>,
+}
+
+#[derive(Deserialize)]
+struct Meta {
+    name: String,
+    sample_rate_hz: f64,
+}
+
+fn read_rows(path: &Path) -> Result<Vec<BTreeMap<String, String>>> {
+    let mut r = csv::Reader::from_path(path).with_context(|| format!("{}", path.display()))?;
+    let mut out = Vec::new();
+    for row in r.deserialize() {
+        out.push(row.with_context(|| format!("{}", path.display()))?);
+    }
+    Ok(out)
+}
+
+fn field<'a>(row: &'a BTreeMap<String, String>, k: &str, path: &Path) -> Result<&'a str> {
+    row.get(k)
+        .map(String::as_str)
+        .with_context(|| format!("{}: no column `{k}`", path.display()))
+}
+
+fn index(row: &BTreeMap<String, String>, k: &str, path: &Path) -> Result<u32> {
+    let v = field(row, k, path)?;
+    v.trim()
+        .parse()
+        .with_context(|| format!("{}: `{k}` = {v:?} is not an index", path.display()))
+}
+
+/// Loads a dataset folder of `../shared/datasets` (its layout is described there).
+pub fn load(dir: &Path) -> Result<Dataset> {
+    let meta_path = dir.join("meta.json");
+    let meta: Meta = serde_json::from_slice(
+        &std::fs::read(&meta_path).with_context(|| format!("{}", meta_path.display()))?,
+    )
+    .with_context(|| format!("{}", meta_path.display()))?;
+    let trials = match meta.name.as_str() {
+        "gaitmap_walk" | "pyshoe_vicon" => load_strides(dir, &meta.name)?,
+        "ipol_gait_events" => load_ipol(dir)?,
+        other => bail!("{}: unknown dataset {other:?}", dir.display()),
+    };
+    Ok(Dataset {
+        name: meta.name,
+        rate_hz: meta.sample_rate_hz,
+        trials,
+    })
+}
+
+fn load_strides(dir: &Path, name: &str) -> Result<Vec<Trial>> {
+    let path = dir.join("strides.csv");
+    let mut by_trial: BTreeMap<String, Vec<Reference>> = BTreeMap::new();
+    for row in read_rows(&path)? {
+        let opt = |k: &str| -> Result<Option<u32>> {
+            match row.get(k) {
+                Some(_) => index(&row, k, &path).map(Some),
+                None => Ok(None),
+            }
+        };
+        let r = Reference {
+            start: index(&row, "start_idx", &path)?,
+            end: index(&row, "end_idx", &path)?,
+            flagged: !field(&row, "flag", &path)?.trim().is_empty(),
+            toe_off: opt("tc_idx")?,
+            heel_strike: opt("ic_idx")?,
+            prev_heel_strike: opt("pre_ic_idx")?,
+        };
+        by_trial
+            .entry(field(&row, "trial", &path)?.to_string())
+            .or_default()
+            .push(r);
+    }
+    let mut trials = Vec::new();
+    for (trial, references) in by_trial {
+        let span = (
+            references.iter().map(|r| r.start).min().unwrap_or(0),
+            references.iter().map(|r| r.end).max().unwrap_or(0),
+        );
+        let stance = if name == "pyshoe_vicon" {
+            let p = dir.join(format!("{trial}.reference.csv"));
+            let mut v = Vec::new();
+            for row in read_rows(&p)? {
+                v.push(field(&row, "stance_vicon", &p)?.trim() == "1");
+            }
+            Some(v)
+        } else {
+            None
+        };
+        trials.push(Trial {
+            csv: dir.join(format!("{trial}.csv")),
+            name: trial,
+            references,
+            span,
+            stance,
+        });
+    }
+    Ok(trials)
+}
+
+fn load_ipol(dir: &Path) -> Result<Vec<Trial>> {
+    let tpath = dir.join("trials.csv");
+    let mut spans = BTreeMap::new();
+    for row in read_rows(&tpath)? {
+        spans.insert(
+            field(&row, "trial", &tpath)?.to_string(),
+            (
+                index(&row, "walk_start_idx", &tpath)?,
+                index(&row, "walk_end_idx", &tpath)?,
+            ),
+        );
+    }
+    let epath = dir.join("events.csv");
+    let mut by_trial: BTreeMap<(String, String), Vec<(u32, Reference)>> = BTreeMap::new();
+    for row in read_rows(&epath)? {
+        let to = index(&row, "toe_off_idx", &epath)?;
+        let hs = index(&row, "heel_strike_idx", &epath)?;
+        let r = Reference {
+            start: to,
+            end: hs,
+            flagged: field(&row, "in_uturn", &epath)?.trim() == "True",
+            toe_off: Some(to),
+            heel_strike: Some(hs),
+            prev_heel_strike: None,
+        };
+        let key = (
+            field(&row, "trial", &epath)?.to_string(),
+            field(&row, "foot", &epath)?.to_string(),
+        );
+        by_trial
+            .entry(key)
+            .or_default()
+            .push((index(&row, "step", &epath)?, r));
+    }
+    let mut trials = Vec::new();
+    for ((trial, foot), mut steps) in by_trial {
+        steps.sort_by_key(|s| s.0);
+        let mut references: Vec<Reference> = steps.into_iter().map(|s| s.1).collect();
+        for k in 1..references.len() {
+            references[k].prev_heel_strike = references[k - 1].heel_strike;
+        }
+        let span = *spans
+            .get(&trial)
+            .with_context(|| format!("{}: no trial {trial}", tpath.display()))?;
+        trials.push(Trial {
+            csv: dir.join(format!("{trial}_{foot}.csv")),
+            name: format!("{trial}_{foot}"),
+            references,
+            span,
+            stance: None,
+        });
+    }
+    Ok(trials)
+}
+
+/// Everything counted over trials.
+#[derive(Clone, Debug, Default)]
+pub struct Tally {
+    /// Trials.
+    pub trials: usize,
+    /// Clean reference strides.
+    pub clean: usize,
+    /// Matched clean strides.
+    pub tp: usize,
+    /// Detections matched to nothing.
+    pub fp: usize,
+    /// Clean references matched to nothing.
+    pub fn_: usize,
+    /// Toe-off errors, ms.
+    pub toe_off_ms: Vec<f64>,
+    /// Heel-strike errors, ms.
+    pub heel_strike_ms: Vec<f64>,
+    /// Swing phase: (tp, fp, fn, IoUs of the true positives).
+    pub swing: PhaseTally,
+    /// Contact phase.
+    pub contact: PhaseTally,
+    /// Stance samples: (tp, fp, fn).
+    pub stance: Option<(u64, u64, u64)>,
+}
+
+/// Counts for one phase.
+#[derive(Clone, Debug, Default)]
+pub struct PhaseTally {
+    /// True positives.
+    pub tp: usize,
+    /// False positives.
+    pub fp: usize,
+    /// False negatives.
+    pub fn_: usize,
+    /// IoU of each true positive.
+    pub iou: Vec<f64>,
+    /// Whether the dataset labels this phase.
+    pub labelled: bool,
+}
+
+impl PhaseTally {
+    fn add(&mut self, o: &PhaseTally) {
+        self.tp += o.tp;
+        self.fp += o.fp;
+        self.fn_ += o.fn_;
+        self.iou.extend_from_slice(&o.iou);
+        self.labelled |= o.labelled;
+    }
+
+    /// Huang's F-score (eq. 9).
+    pub fn f_score(&self) -> f64 {
+        f1(self.tp as f64, self.fp as f64, self.fn_ as f64)
+    }
+
+    /// Mean IoU of the true positives (eq. 10).
+    pub fn mean_iou(&self) -> f64 {
+        mean(&self.iou)
+    }
+}
+
+impl Tally {
+    /// Adds another tally into this one.
+    pub fn add(&mut self, o: &Tally) {
+        self.trials += o.trials;
+        self.clean += o.clean;
+        self.tp += o.tp;
+        self.fp += o.fp;
+        self.fn_ += o.fn_;
+        self.toe_off_ms.extend_from_slice(&o.toe_off_ms);
+        self.heel_strike_ms.extend_from_slice(&o.heel_strike_ms);
+        self.swing.add(&o.swing);
+        self.contact.add(&o.contact);
+        self.stance = match (self.stance, o.stance) {
+            (Some(a), Some(b)) => Some((a.0 + b.0, a.1 + b.1, a.2 + b.2)),
+            (a, b) => a.or(b),
+        };
+    }
+
+    /// Stride precision.
+    pub fn precision(&self) -> f64 {
+        ratio(self.tp as f64, (self.tp + self.fp) as f64)
+    }
+
+    /// Stride recall.
+    pub fn recall(&self) -> f64 {
+        ratio(self.tp as f64, (self.tp + self.fn_) as f64)
+    }
+
+    /// Stride F1.
+    pub fn f1(&self) -> f64 {
+        f1(self.tp as f64, self.fp as f64, self.fn_ as f64)
+    }
+
+    /// Stance sample-wise F1, if labelled.
+    pub fn stance_f1(&self) -> Option<f64> {
+        self.stance.map(|(tp, fp, fn_)| f1(tp as f64, fp as f64, fn_ as f64))
+    }
+}
+
+fn ratio(a: f64, b: f64) -> f64 {
+    if b > 0.0 {
+        a / b
+    } else {
+        f64::NAN
+    }
+}
+
+fn f1(tp: f64, fp: f64, fn_: f64) -> f64 {
+    ratio(2.0 * tp, 2.0 * tp + fp + fn_)
+}
+
+fn mean(v: &[f64]) -> f64 {
+    ratio(v.iter().sum(), v.len() as f64)
+}
+
+/// `q`-quantile of the absolute values (nearest rank), NaN when empty.
+pub fn abs_quantile(v: &[f64], q: f64) -> f64 {
+    let mut a: Vec<f64> = v.iter().map(|x| x.abs()).collect();
+    if a.is_empty() {
+        return f64::NAN;
+    }
+    a.sort_by(f64::total_cmp);
+    let k = ((q * a.len() as f64).ceil() as usize).clamp(1, a.len()) - 1;
+    a[k]
+}
+
+fn overlap(a: (u32, u32), b: (u32, u32)) -> u32 {
+    a.1.min(b.1).saturating_sub(a.0.max(b.0))
+}
+
+fn iou(a: (u32, u32), b: (u32, u32)) -> f64 {
+    let union = a.1.max(b.1).saturating_sub(a.0.min(b.0));
+    ratio(overlap(a, b) as f64, union as f64)
+}
+
+/// Pairs detections with references (indices), greedily by overlap, one to one.
+pub fn match_strides(det: &[Detected], refs: &[Reference]) -> Vec<(usize, usize)> {
+    let mut cand = Vec::new();
+    for (i, d) in det.iter().enumerate() {
+        let dm = (d.heel_off, d.end);
+        for (j, r) in refs.iter().enumerate() {
+            let rm = (r.start, r.end);
+            let ov = overlap(dm, rm);
+            let shorter = (dm.1 - dm.0).min(rm.1.saturating_sub(rm.0));
+            if ov > 0 && 2 * ov >= shorter {
+                cand.push((ov, i, j));
+            }
+        }
+    }
+    cand.sort_by(|a, b| b.0.cmp(&a.0).then(a.1.cmp(&b.1)));
+    let (mut used_d, mut used_r) = (vec![false; det.len()], vec![false; refs.len()]);
+    let mut out = Vec::new();
+    for (_, i, j) in cand {
+        if !used_d[i] && !used_r[j] {
+            used_d[i] = true;
+            used_r[j] = true;
+            out.push((i, j));
+        }
+    }
+    out
+}
+
+/// Scores one trial's detections.
+pub fn score(trial: &Trial, det: &[Detected], rate_hz: f64) -> Tally {
+    let in_span = |d: &Detected| overlap((d.heel_off, d.end), trial.span) > 0;
+    let det: Vec<Detected> = det.iter().copied().filter(in_span).collect();
+    let refs = &trial.references;
+    let pairs = match_strides(&det, refs);
+    let mut t = Tally {
+        trials: 1,
+        clean: refs.iter().filter(|r| !r.flagged).count(),
+        ..Tally::default()
+    };
+    let mut matched_d = vec![None; det.len()];
+    for &(i, j) in &pairs {
+        matched_d[i] = Some(j);
+    }
+    let ms = |samples: f64| samples * 1000.0 / rate_hz;
+    t.swing.labelled = refs.iter().any(|r| r.toe_off.is_some());
+    t.contact.labelled = refs.iter().any(|r| r.prev_heel_strike.is_some());
+    for (i, d) in det.iter().enumerate() {
+        let prev = i
+            .checked_sub(1)
+            .map(|k| det[k])
+            .filter(|p| p.end == d.start);
+        match matched_d[i].map(|j| (j, refs[j])) {
+            Some((_, r)) if r.flagged => {}
+            Some((_, r)) => {
+                t.tp += 1;
+                if let (Some(to), Some(hs)) = (r.toe_off, r.heel_strike) {
+                    t.toe_off_ms.push(ms(d.toe_off as f64 - to as f64));
+                    t.heel_strike_ms.push(ms(d.heel_strike as f64 - hs as f64));
+                    let v = iou((d.toe_off, d.heel_strike), (to, hs));
+                    phase(&mut t.swing, Some(v));
+                }
+                if let (Some(phs), Some(to)) = (r.prev_heel_strike, r.toe_off) {
+                    let v = prev.map(|p| iou((p.heel_strike, d.toe_off), (phs, to)));
+                    phase(&mut t.contact, v);
+                }
+            }
+            None => {
+                t.fp += 1;
+                t.swing.fp += t.swing.labelled as usize;
+                t.contact.fp += (t.contact.labelled && prev.is_some()) as usize;
+            }
+        }
+    }
+    t.fn_ = t.clean - t.tp;
+    for (ph, labelled) in [
+        (&mut t.swing, refs.iter().filter(|r| !r.flagged && r.toe_off.is_some()).count()),
+        (
+            &mut t.contact,
+            refs.iter()
+                .filter(|r| !r.flagged && r.prev_heel_strike.is_some())
+                .count(),
+        ),
+    ] {
+        ph.fn_ = labelled - ph.tp;
+    }
+    if let Some(label) = &trial.stance {
+        let mut moving = vec![false; label.len()];
+        for d in &det {
+            for m in moving
+                .iter_mut()
+                .take(d.end as usize)
+                .skip(d.heel_off as usize)
+            {
+                *m = true;
+            }
+        }
+        let (mut tp, mut fp, mut fn_) = (0, 0, 0);
+        let to = (trial.span.1 as usize).min(label.len());
+        for k in trial.span.0 as usize..to {
+            match (!moving[k], label[k]) {
+                (true, true) => tp += 1,
+                (true, false) => fp += 1,
+                (false, true) => fn_ += 1,
+                (false, false) => {}
+            }
+        }
+        t.stance = Some((tp, fp, fn_));
+    }
+    t
+}
+
+/// A matched phase: a true positive at IoU ≥ 0.5, else one false positive (the detected
+/// segment is wrong) — its reference is then counted missed by the caller's `fn_`.
+fn phase(p: &mut PhaseTally, v: Option<f64>) {
+    match v {
+        Some(v) if v >= 0.5 => {
+            p.tp += 1;
+            p.iou.push(v);
+        }
+        Some(_) => p.fp += 1,
+        None => {}
+    }
+}
+
+/// A rotation matrix drawn uniformly (from a random unit quaternion).
+pub fn random_rotation(rng: &mut impl Rng) -> [[f64; 3]; 3] {
+    let q: [f64; 4] = loop {
+        let v = [0; 4].map(|_| rng.random_range(-1.0..1.0f64));
+        let n = v.iter().map(|x| x * x).sum::<f64>().sqrt();
+        if n > 0.1 && n <= 1.0 {
+            break v.map(|x| x / n);
+        }
+    };
+    let [w, x, y, z] = q;
+    [
+        [1.0 - 2.0 * (y * y + z * z), 2.0 * (x * y - w * z), 2.0 * (x * z + w * y)],
+        [2.0 * (x * y + w * z), 1.0 - 2.0 * (x * x + z * z), 2.0 * (y * z - w * x)],
+        [2.0 * (x * z - w * y), 2.0 * (y * z + w * x), 1.0 - 2.0 * (x * x + y * y)],
+    ]
+}
+
+/// The trace as a clip mounted at rotation `r` would have recorded it.
+pub fn rotate(samples: &[ImuSample], r: &[[f64; 3]; 3]) -> Vec<ImuSample> {
+    let mul = |v: [f64; 3]| r.map(|row| row[0] * v[0] + row[1] * v[1] + row[2] * v[2]);
+    samples
+        .iter()
+        .map(|s| ImuSample {
+            t_s: s.t_s,
+            acc_mps2: mul(s.acc_mps2),
+            gyr_radps: mul(s.gyr_radps),
+        })
+        .collect()
+}
+
+/// A detector under evaluation: from a trace (counts at `ranges`) to strides.
+pub type Detector<'a> = &'a dyn Fn(&Trace, Ranges) -> Result<Vec<Detected>>;
+
+/// Results of one dataset: the tally of the unrotated traces, and one per rotation.
+pub struct DatasetResult {
+    /// Dataset name.
+    pub name: String,
+    /// As recorded.
+    pub tally: Tally,
+    /// After each random rotation.
+    pub rotated: Vec<Tally>,
+}
+
+/// Runs `detector` on every trial of `dataset`, as recorded and after `rotations` random
+/// rotations (seeded by `seed`, one sequence per trial).
+pub fn evaluate(
+    dataset: &Dataset,
+    detector: Detector,
+    rotations: usize,
+    seed: u64,
+) -> Result<DatasetResult> {
+    let ranges = Ranges::default();
+    let mut tally = Tally::default();
+    let mut rotated = vec![Tally::default(); rotations];
+    for (k, trial) in dataset.trials.iter().enumerate() {
+        let trace = csv_trace::read(&trial.csv, Some(dataset.rate_hz))?;
+        tally.add(&score(trial, &detector(&trace, ranges)?, dataset.rate_hz));
+        let mut rng = ChaCha8Rng::seed_from_u64(seed ^ (k as u64).wrapping_mul(0x9E37_79B9));
+        for r in rotated.iter_mut() {
+            let m = random_rotation(&mut rng);
+            let t = Trace {
+                samples: rotate(&trace.samples, &m),
+                rate_hz: trace.rate_hz,
+            };
+            r.add(&score(trial, &detector(&t, ranges)?, dataset.rate_hz));
+        }
+    }
+    Ok(DatasetResult {
+        name: dataset.name.clone(),
+        tally,
+        rotated,
+    })
+}
+
+fn fmt3(v: f64) -> String {
+    if v.is_nan() {
+        "–".into()
+    } else {
+        format!("{v:.3}")
+    }
+}
+
+/// Median of signed values, NaN when empty.
+pub fn median(v: &[f64]) -> f64 {
+    let mut a = v.to_vec();
+    if a.is_empty() {
+        return f64::NAN;
+    }
+    a.sort_by(f64::total_cmp);
+    a[a.len() / 2]
+}
+
+fn fmt_ms(v: &[f64]) -> String {
+    if v.is_empty() {
+        "–".into()
+    } else {
+        format!(
+            "{:.0} / {:.0} ({:+.0})",
+            abs_quantile(v, 0.5),
+            abs_quantile(v, 0.95),
+            median(v)
+        )
+    }
+}
+
+fn phase_cell(p: &PhaseTally) -> String {
+    if p.labelled {
+        format!("{} / {}", fmt3(p.f_score()), fmt3(p.mean_iou()))
+    } else {
+        "–".into()
+    }
+}
+
+/// The Markdown table: one row per dataset and an overall row; with rotations, one more
+/// table of the rotated runs pooled and the largest change of any rotation.
+pub fn table(results: &[DatasetResult]) -> String {
+    let mut s = String::new();
+    let header = "| dataset | trials | clean strides | found | extra | missed | precision | recall | F1 | toe-off \\|error\\| ms: median / p95 (signed median) | heel-strike \\|error\\| ms: median / p95 (signed median) | swing F / IoU | contact F / IoU | stance F1 |\n|---|---|---|---|---|---|---|---|---|---|---|---|---|---|\n";
+    let row = |s: &mut String, name: &str, t: &Tally| {
+        let _ = writeln!(
+            s,
+            "| {name} | {} | {} | {} | {} | {} | {} | {} | {} | {} | {} | {} | {} | {} |",
+            t.trials,
+            t.clean,
+            t.tp,
+            t.fp,
+            t.fn_,
+            fmt3(t.precision()),
+            fmt3(t.recall()),
+            fmt3(t.f1()),
+            fmt_ms(&t.toe_off_ms),
+            fmt_ms(&t.heel_strike_ms),
+            phase_cell(&t.swing),
+            phase_cell(&t.contact),
+            t.stance_f1().map_or("–".into(), fmt3),
+        );
+    };
+    s.push_str(header);
+    let mut overall = Tally::default();
+    for r in results {
+        row(&mut s, &r.name, &r.tally);
+        overall.add(&r.tally);
+    }
+    if results.len() > 1 {
+        row(&mut s, "**overall**", &overall);
+    }
+    let n = results.first().map_or(0, |r| r.rotated.len());
+    if n > 0 {
+        let _ = writeln!(s, "\nAfter {n} random rotations of every trace (pooled):\n");
+        s.push_str(header);
+        let mut overall = Tally::default();
+        for r in results {
+            let mut pooled = Tally::default();
+            for t in &r.rotated {
+                pooled.add(t);
+            }
+            pooled.trials = r.tally.trials;
+            pooled.clean = r.tally.clean;
+            row(&mut s, &r.name, &pooled);
+            overall.add(&pooled);
+        }
+        if results.len() > 1 {
+            row(&mut s, "**overall**", &overall);
+        }
+        let _ = writeln!(
+            s,
+            "\nLargest change of any single rotation from the unrotated figures:\n\n| dataset | F1 | toe-off median ms | heel-strike median ms | swing IoU | stance F1 |\n|---|---|---|---|---|---|"
+        );
+        for r in results {
+            let t = &r.tally;
+            let d = |f: &dyn Fn(&Tally) -> f64| {
+                r.rotated
+                    .iter()
+                    .map(|x| (f(x) - f(t)).abs())
+                    .filter(|v| !v.is_nan())
+                    .fold(0.0f64, f64::max)
+            };
+            let _ = writeln!(
+                s,
+                "| {} | {:.3} | {:.1} | {:.1} | {:.3} | {} |",
+                r.name,
+                d(&|x| x.f1()),
+                d(&|x| abs_quantile(&x.toe_off_ms, 0.5)),
+                d(&|x| abs_quantile(&x.heel_strike_ms, 0.5)),
+                d(&|x| x.swing.mean_iou()),
+                if t.stance.is_some() {
+                    format!("{:.3}", d(&|x| x.stance_f1().unwrap_or(f64::NAN)))
+                } else {
+                    "–".into()
+                },
+            );
+        }
+    }
+    s
+}
