@@ -5,7 +5,8 @@
 //! sagittal acceleration, mean-filtered, in g/2048.
 //!
 //! 1. **Peaks and valleys** of both signals: local maxima above [`MIN_EXTREME_MG`] and local
-//!    minima below its negative (smaller wiggles are sensor noise).
+//!    minima below its negative (smaller wiggles are sensor noise); a flat top counts once,
+//!    at its middle.
 //! 2. **Two clusters** (Algorithm 1): 1-D k-means, k = 2, on the sample positions of all
 //!    extremes, centres started at the movement's first and last sample, at most 50
 //!    iterations. The left cluster holds the push-off's force changes, the right one the
@@ -36,7 +37,8 @@ pub const MIN_EXTREME_MG: i32 = 100;
 /// Condition (3): a second pair's peak within this many ms of the major valley merges
 /// (5 samples at Huang's 100 Hz).
 pub const MERGE_MS: u32 = 50;
-/// At most this many extremes per movement are considered; later ones are ignored.
+/// At most this many extremes per movement are considered (vertical first, then sagittal);
+/// later ones are ignored.
 pub const MAX_EXTREMES: usize = 256;
 /// Iteration cap of the k-means (Algorithm 1).
 pub const KMEANS_MAX_ITERATIONS: u32 = 50;
@@ -176,20 +178,37 @@ pub fn split(movement: &[[i16; 2]], method: PhaseMethod, merge_samples: u32) -> 
 fn find_extremes(movement: &[[i16; 2]]) -> Vec<Extreme, MAX_EXTREMES> {
     let min = MIN_EXTREME_MG * crate::foot_frame::FOOT_LSB_PER_G / 1000;
     let mut out = Vec::new();
-    for (i, w) in movement.windows(3).enumerate() {
-        for axis in [VERTICAL, SAGITTAL] {
-            let a = axis as usize;
-            let (prev, x, next) = (w[0][a] as i32, w[1][a] as i32, w[2][a] as i32);
-            let peak = x > prev && x >= next && x > min;
-            let valley = x < prev && x <= next && x < -min;
-            if peak || valley {
-                let _ = out.push(Extreme {
-                    at: i as u32 + 1,
-                    value: x,
-                    axis,
-                    peak,
-                });
+    let len = movement.len();
+    for axis in [VERTICAL, SAGITTAL] {
+        let a = axis as usize;
+        let x = |i: usize| movement[i][a] as i32;
+        let mut i = 1;
+        while i + 1 < len {
+            // A plateau of equal values counts once, at its middle (integer signals of slow
+            // peaks are flat for several samples).
+            let mut j = i;
+            while j + 1 < len && x(j + 1) == x(i) {
+                j += 1;
             }
+            if j + 1 >= len {
+                break;
+            }
+            let (prev, v, next) = (x(i - 1), x(i), x(j + 1));
+            let peak = v > prev && v > next && v > min;
+            let valley = v < prev && v < next && v < -min;
+            if (peak || valley)
+                && out
+                    .push(Extreme {
+                        at: ((i + j) / 2) as u32,
+                        value: v,
+                        axis,
+                        peak,
+                    })
+                    .is_err()
+            {
+                break;
+            }
+            i = j + 1;
         }
     }
     out

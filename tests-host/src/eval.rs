@@ -670,8 +670,6 @@ pub fn table(results: &[DatasetResult]) -> String {
             for t in &r.rotated {
                 pooled.add(t);
             }
-            pooled.trials = r.tally.trials;
-            pooled.clean = r.tally.clean;
             row(&mut s, &r.name, &pooled);
             overall.add(&pooled);
         }

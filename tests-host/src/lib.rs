@@ -9,6 +9,7 @@ pub mod firmware;
 pub mod fixtures;
 pub mod mcap_io;
 pub mod qemu;
+pub mod reference;
 pub mod replay;
 pub mod sim;
 pub mod trace;
