@@ -34,6 +34,9 @@ pub const REMOUNT_DEG: u32 = 25;
 pub const AXIS_MIN_MOVEMENT_MS: u32 = 250;
 /// …and shorter than this (walking, not fiddling with the shoe).
 pub const AXIS_MAX_MOVEMENT_MS: u32 = 2500;
+/// The very first frame is set once the first rest has lasted this long, so that the stance
+/// detector is running before the first step (later rests update it when they end).
+pub const FIRST_FRAME_AFTER_MS: u32 = 100;
 /// Foot-frame accelerations are in units of g/[`FOOT_LSB_PER_G`] whatever the sensor's
 /// range: the counts of the ±16 g range.
 pub const FOOT_LSB_PER_G: i32 = 2048;
@@ -66,16 +69,19 @@ impl FootFrame {
     /// is within 1 unit (0.5 mg) plus rounding of the exact rotation for any `i16` input.
     pub fn apply(&self, accel: [i16; 3]) -> [i16; 3] {
         let mut out = [0i16; 3];
-        for (o, row) in out.iter_mut().zip(self.rows.iter()) {
+        for (k, (o, row)) in out.iter_mut().zip(self.rows.iter()).enumerate() {
             // |row| ≤ 2¹⁴·√(Σ) per axis and |a| ≤ 2¹⁵: each product < 2²⁹, the sum < 2³¹.
             let dot: i64 = row
                 .iter()
                 .zip(accel.iter())
                 .map(|(&r, &a)| r as i64 * a as i64)
                 .sum();
-            *o = ((dot + (1 << 13)) >> 14).clamp(-32_767, 32_767) as i16;
+            let mut v = (dot + (1 << 13)) >> 14;
+            if k == 2 {
+                v -= self.gravity as i64;
+            }
+            *o = v.clamp(-32_767, 32_767) as i16;
         }
-        out[2] = (out[2] as i32 - self.gravity).clamp(-32_767, 32_767) as i16;
         out
     }
 
@@ -102,6 +108,7 @@ pub struct FootFrameEstimator {
     accel: AccelRange,
     axis_min: u32,
     axis_max: u32,
+    first_after: u32,
     frame: Option<FootFrame>,
     up: [f32; 3],
     gravity_counts: f32,
@@ -126,6 +133,7 @@ impl FootFrameEstimator {
             accel,
             axis_min: rate.samples_in_ms(AXIS_MIN_MOVEMENT_MS),
             axis_max: rate.samples_in_ms(AXIS_MAX_MOVEMENT_MS),
+            first_after: rate.samples_in_ms(FIRST_FRAME_AFTER_MS),
             frame: None,
             up: [0.0; 3],
             gravity_counts: 0.0,
@@ -183,6 +191,9 @@ impl FootFrameEstimator {
             self.rest_gyro[i] += s.gyro[i] as i64;
         }
         self.rest_n += 1;
+        if self.frame.is_none() && self.rest_n == self.first_after {
+            self.end_rest();
+        }
     }
 
     fn accumulate_movement(&mut self, s: &RawSample) {
@@ -202,9 +213,15 @@ impl FootFrameEstimator {
         for (c, p) in self.cov.iter_mut().zip(products) {
             *c += p;
         }
-        for i in 0..3 {
-            self.sum_w[i] += w[i];
-            self.moment[i] += w[i] * self.move_n as i64;
+        let k = self.move_n as i64;
+        for ((s, m), &w) in self
+            .sum_w
+            .iter_mut()
+            .zip(self.moment.iter_mut())
+            .zip(w.iter())
+        {
+            *s += w;
+            *m += w * k;
         }
         self.move_n += 1;
     }
@@ -221,7 +238,7 @@ impl FootFrameEstimator {
         });
         let m = Vector3::from(mean);
         let g = m.norm();
-        if !(g > 0.0) {
+        if g.is_nan() || g <= 0.0 {
             return;
         }
         let u = m / g;
@@ -240,8 +257,7 @@ impl FootFrameEstimator {
     }
 
     fn end_movement(&mut self) {
-        if self.frame.is_none() || self.move_n < self.axis_min || self.move_n >= self.axis_max
-        {
+        if self.frame.is_none() || self.move_n < self.axis_min || self.move_n >= self.axis_max {
             return;
         }
         let c = self.cov.map(|v| v as f32);
@@ -261,9 +277,8 @@ impl FootFrameEstimator {
             return;
         }
         let n = self.move_n as f32;
-        let centred = [0, 1, 2].map(|i| {
-            self.moment[i] as f32 - self.sum_w[i] as f32 * (n - 1.0) * 0.5
-        });
+        let centred =
+            [0, 1, 2].map(|i| self.moment[i] as f32 - self.sum_w[i] as f32 * (n - 1.0) * 0.5);
         let sign = if horizontal.dot(&Vector3::from(centred)) < 0.0 {
             1.0
         } else {
@@ -296,8 +311,8 @@ impl FootFrameEstimator {
         let forward = left.cross(&up);
         let scale = (1u32 << 14) as f32 * FOOT_LSB_PER_G as f32 / self.accel.lsb_per_g() as f32;
         let row = |v: Vector3<f32>| [0, 1, 2].map(|i| libm_round(v[i] * scale));
-        let gravity = libm_round(self.gravity_counts * FOOT_LSB_PER_G as f32
-            / self.accel.lsb_per_g() as f32);
+        let gravity =
+            libm_round(self.gravity_counts * FOOT_LSB_PER_G as f32 / self.accel.lsb_per_g() as f32);
         self.frame = Some(FootFrame {
             rows: [row(forward), row(left), row(up)],
             gravity,

@@ -232,8 +232,8 @@ fn kmeans(extremes: &[Extreme], len: u32) -> (u32, u32) {
         }
         let mut next = c;
         for k in 0..2 {
-            if count[k] > 0 {
-                next[k] = ((sum[k] + count[k] / 2) / count[k]) as u32;
+            if let Some(mean) = (sum[k] + count[k] / 2).checked_div(count[k]) {
+                next[k] = mean as u32;
             }
         }
         if next == c {

@@ -94,9 +94,8 @@ pub struct Pipeline {
 impl Pipeline {
     /// A pipeline for data described by `config`.
     pub const fn new(config: Config) -> Self {
-        let filter = MeanFilter::with_len_log2(log2_nearest(
-            config.rate.samples_in_ms(MEAN_FILTER_MS),
-        ));
+        let filter =
+            MeanFilter::with_len_log2(log2_nearest(config.rate.samples_in_ms(MEAN_FILTER_MS)));
         let rest = RestDetector::new(RestThresholds::new(config.rate, config.accel, config.gyro));
         let stance = StanceDetector::new(StanceThresholds::new(config.rate, config.gyro));
         let rest_delay = rest.delay() + filter.delay();

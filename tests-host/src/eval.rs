@@ -351,7 +351,8 @@ impl Tally {
 
     /// Stance sample-wise F1, if labelled.
     pub fn stance_f1(&self) -> Option<f64> {
-        self.stance.map(|(tp, fp, fn_)| f1(tp as f64, fp as f64, fn_ as f64))
+        self.stance
+            .map(|(tp, fp, fn_)| f1(tp as f64, fp as f64, fn_ as f64))
     }
 }
 
@@ -465,7 +466,12 @@ pub fn score(trial: &Trial, det: &[Detected], rate_hz: f64) -> Tally {
     }
     t.fn_ = t.clean - t.tp;
     for (ph, labelled) in [
-        (&mut t.swing, refs.iter().filter(|r| !r.flagged && r.toe_off.is_some()).count()),
+        (
+            &mut t.swing,
+            refs.iter()
+                .filter(|r| !r.flagged && r.toe_off.is_some())
+                .count(),
+        ),
         (
             &mut t.contact,
             refs.iter()
@@ -525,9 +531,21 @@ pub fn random_rotation(rng: &mut impl Rng) -> [[f64; 3]; 3] {
     };
     let [w, x, y, z] = q;
     [
-        [1.0 - 2.0 * (y * y + z * z), 2.0 * (x * y - w * z), 2.0 * (x * z + w * y)],
-        [2.0 * (x * y + w * z), 1.0 - 2.0 * (x * x + z * z), 2.0 * (y * z - w * x)],
-        [2.0 * (x * z - w * y), 2.0 * (y * z + w * x), 1.0 - 2.0 * (x * x + y * y)],
+        [
+            1.0 - 2.0 * (y * y + z * z),
+            2.0 * (x * y - w * z),
+            2.0 * (x * z + w * y),
+        ],
+        [
+            2.0 * (x * y + w * z),
+            1.0 - 2.0 * (x * x + z * z),
+            2.0 * (y * z - w * x),
+        ],
+        [
+            2.0 * (x * z - w * y),
+            2.0 * (y * z + w * x),
+            1.0 - 2.0 * (x * x + y * y),
+        ],
     ]
 }
 

@@ -8,7 +8,9 @@
 //! computation (means, variances, rotations, deflation, quartiles, k-means, fusion) is done
 //! here in `f64` on the physical values of the same input counts.
 
-use gaitclip::foot_frame::{AXIS_MAX_MOVEMENT_MS, AXIS_MIN_MOVEMENT_MS, REMOUNT_DEG};
+use gaitclip::foot_frame::{
+    AXIS_MAX_MOVEMENT_MS, AXIS_MIN_MOVEMENT_MS, FIRST_FRAME_AFTER_MS, REMOUNT_DEG,
+};
 use gaitclip::phases::{
     PhaseMethod, KMEANS_MAX_ITERATIONS, MAX_EXTREMES, MERGE_MS, MIN_EXTREME_MG,
 };
@@ -28,7 +30,10 @@ pub fn strides(samples: &[RawSample], config: Config) -> Vec<Detected> {
         accel: config.accel,
         gyro: config.gyro,
     };
-    let (ka, kg) = (ranges.accel_counts_per_mps2(), ranges.gyro_counts_per_radps());
+    let (ka, kg) = (
+        ranges.accel_counts_per_mps2(),
+        ranges.gyro_counts_per_radps(),
+    );
     let acc: Vec<Vector3<f64>> = samples
         .iter()
         .map(|s| Vector3::from(s.accel.map(|c| c as f64 / ka)))
@@ -91,8 +96,12 @@ impl Reference {
             if i + 1 >= w && i >= rest_delay {
                 let win = &filtered[i + 1 - w..=i];
                 let mean = win.iter().sum::<Vector3<f64>>() / w as f64;
-                let var: f64 = win.iter().map(|a| (a - mean).norm_squared()).sum::<f64>() / w as f64;
-                let energy: f64 = gyr[i + 1 - w..=i].iter().map(|g| g.norm_squared()).sum::<f64>()
+                let var: f64 =
+                    win.iter().map(|a| (a - mean).norm_squared()).sum::<f64>() / w as f64;
+                let energy: f64 = gyr[i + 1 - w..=i]
+                    .iter()
+                    .map(|g| g.norm_squared())
+                    .sum::<f64>()
                     / w as f64;
                 let is_rest = var < a_max * a_max && energy < g_rest * g_rest;
                 let at = i - rest_delay;
@@ -132,7 +141,10 @@ impl Reference {
                 still &= v[3 * q / 4] - v[q / 4] < iqr_max;
             }
             let h = self.half[1];
-            let energy = gyr[c - h..=c + h].iter().map(|g| g.norm_squared()).sum::<f64>()
+            let energy = gyr[c - h..=c + h]
+                .iter()
+                .map(|g| g.norm_squared())
+                .sum::<f64>()
                 / (2 * h + 1) as f64;
             still &= energy < gyro_max * gyro_max;
             if c >= fd {
@@ -148,9 +160,10 @@ impl Reference {
         // End of the recording: the core drains the last `big` decisions with the last
         // answer, then reports what it still holds.
         if let Some(&(c_last, still)) = decisions.last() {
-            for c in c_last + 1..(c_last + 1 + big).min(n) {
+            let drained = (c_last + 1 + big).min(n);
+            for (c, f) in foot.iter().enumerate().take(drained).skip(c_last + 1) {
                 let at = c - fd;
-                out.extend(tracker.process(at, &foot[c], sat[at], still));
+                out.extend(tracker.process(at, f, sat[at], still));
             }
         }
         out.extend(tracker.finish());
@@ -180,6 +193,7 @@ impl Frame {
 struct FrameEstimator {
     axis_min: usize,
     axis_max: usize,
+    first_after: usize,
     frame: Option<Frame>,
     up: Vector3<f64>,
     gravity: f64,
@@ -195,6 +209,7 @@ impl FrameEstimator {
         FrameEstimator {
             axis_min: ms(rate, AXIS_MIN_MOVEMENT_MS),
             axis_max: ms(rate, AXIS_MAX_MOVEMENT_MS),
+            first_after: ms(rate, FIRST_FRAME_AFTER_MS),
             frame: None,
             up: Vector3::zeros(),
             gravity: 0.0,
@@ -216,7 +231,12 @@ impl FrameEstimator {
                 self.end_movement();
                 self.rest = vec![(a, w)];
             }
-            (true, true) => self.rest.push((a, w)),
+            (true, true) => {
+                self.rest.push((a, w));
+                if self.frame.is_none() && self.rest.len() == self.first_after {
+                    self.end_rest();
+                }
+            }
             (true, false) => {
                 self.end_rest();
                 self.movement.clear();
@@ -270,7 +290,11 @@ impl FrameEstimator {
             .enumerate()
             .map(|(k, w)| w * (k as f64 - centre))
             .sum();
-        let sign = if horizontal.dot(&moment) < 0.0 { 1.0 } else { -1.0 };
+        let sign = if horizontal.dot(&moment) < 0.0 {
+            1.0
+        } else {
+            -1.0
+        };
         self.left_sum = self.left_sum * 0.875 + horizontal.normalize() * sign;
         self.rebuild();
     }
@@ -328,7 +352,13 @@ impl Tracker {
         }
     }
 
-    fn process(&mut self, at: usize, foot: &[f64; 3], _sat: bool, stance: bool) -> Option<Detected> {
+    fn process(
+        &mut self,
+        at: usize,
+        foot: &[f64; 3],
+        _sat: bool,
+        stance: bool,
+    ) -> Option<Detected> {
         match (&self.state, stance) {
             (State::Unprimed, false) => None,
             (State::Unprimed, true) => {
@@ -539,8 +569,8 @@ pub fn split(m: &[[f64; 2]], method: PhaseMethod, merge: usize) -> (usize, usize
                     .map(|(_, &v)| v)
                     .collect();
                 let mean = others.iter().sum::<f64>() / others.len() as f64;
-                let var = others.iter().map(|v| (v - mean).powi(2)).sum::<f64>()
-                    / others.len() as f64;
+                let var =
+                    others.iter().map(|v| (v - mean).powi(2)).sum::<f64>() / others.len() as f64;
                 (x - mean).abs() <= 3.0 * var.sqrt()
             })
             .map(|(_, &x)| x)

@@ -87,3 +87,53 @@ fn gaitmap_walk_strides_and_lengths() {
         assert!(err.abs() < 0.05, "{trial}: distance error {err}");
     }
 }
+
+/// The gait core scored against the events and strides of the recordings, as
+/// `gaitclip eval` reports them; the bounds sit just under what the README's table shows so
+/// that a regression fails here.
+#[test]
+fn eval_figures_on_recordings() {
+    use gaitclip::pipeline::Config;
+    use gaitclip_host::eval::{self, abs_quantile, Detected};
+    use gaitclip_host::replay::core_strides;
+    use gaitclip_host::trace::{Ranges, Trace};
+    let Some(root) = gaitclip_host::datasets::root_or_skip("eval_figures_on_recordings") else {
+        return;
+    };
+    let detector = |t: &Trace, r: Ranges| -> anyhow::Result<Vec<Detected>> {
+        let config = Config::new(t.sample_rate().unwrap(), r.accel, r.gyro);
+        let counts: Vec<_> = t.samples.iter().map(|s| r.to_counts(s)).collect();
+        Ok(core_strides(&counts, config)
+            .iter()
+            .map(Detected::from)
+            .collect())
+    };
+    // (dataset, min F1, max median |toe-off|, |heel-strike| ms, min swing IoU)
+    for (name, f1, to, hs, iou) in [
+        ("gaitmap_walk", 0.97, 30.0, 70.0, 0.80),
+        ("pyshoe_vicon", 0.87, f64::NAN, f64::NAN, f64::NAN),
+        ("ipol_gait_events", 0.94, 45.0, 35.0, 0.82),
+    ] {
+        let d = eval::load(&root.join(name)).unwrap();
+        let r = eval::evaluate(&d, &detector, 0, 1).unwrap();
+        let t = &r.tally;
+        let (m_to, m_hs) = (
+            abs_quantile(&t.toe_off_ms, 0.5),
+            abs_quantile(&t.heel_strike_ms, 0.5),
+        );
+        eprintln!(
+            "{name}: F1 {:.3}, toe-off {m_to:.0} ms, heel-strike {m_hs:.0} ms, swing IoU {:.3}",
+            t.f1(),
+            t.swing.mean_iou()
+        );
+        assert!(t.f1() >= f1, "{name}: F1 {}", t.f1());
+        if !to.is_nan() {
+            assert!(m_to <= to && m_hs <= hs, "{name}: {m_to} / {m_hs} ms");
+            assert!(
+                t.swing.mean_iou() >= iou,
+                "{name}: IoU {}",
+                t.swing.mean_iou()
+            );
+        }
+    }
+}

@@ -4,8 +4,9 @@
 use gaitclip::fixed::{isqrt_u64, mul_q30, QuatQ30, Q30_ONE};
 use gaitclip::mean_filter::MeanFilter;
 use gaitclip::rate::SampleRate;
+use gaitclip::rest::{RestThresholds, ACCEL_STD_MAX_MMPS2, GYRO_RMS_MAX_MRADPS};
 use gaitclip::sample::{AccelRange, GyroRange, RawSample};
-use gaitclip::stance::{StanceThresholds, ACCEL_STD_MAX_MMPS2, GYRO_RMS_MAX_MRADPS};
+use gaitclip::stance::{deflate, StanceThresholds, DEFLATED_IQR_MAX, DEFLATED_STD_MAX};
 use gaitclip::zupt::ZuptIntegrator;
 use gaitclip_host::fixtures::FIRMWARE_TRACE;
 use rand::{Rng, SeedableRng};
@@ -220,12 +221,12 @@ fn sample_rate_conversions() {
 }
 
 #[test]
-fn stance_thresholds_match_physical_units_within_one_count() {
+fn rest_thresholds_match_physical_units_within_one_count() {
     for (accel, gyro) in [
         (AccelRange::G16, GyroRange::Dps2000),
         (AccelRange::G2, GyroRange::Dps250),
     ] {
-        let t = StanceThresholds::new(SampleRate::from_hz(200).unwrap(), accel, gyro);
+        let t = RestThresholds::new(SampleRate::from_hz(200).unwrap(), accel, gyro);
         let a = ACCEL_STD_MAX_MMPS2 as f64 / 1000.0 * accel.lsb_per_g() as f64 / 9.80665;
         let g = GYRO_RMS_MAX_MRADPS as f64 / 1000.0 * 180.0 / std::f64::consts::PI
             * gyro.lsb_per_dps_x10() as f64
@@ -233,6 +234,103 @@ fn stance_thresholds_match_physical_units_within_one_count() {
         assert!(((t.accel_var_counts2 as f64).sqrt() - a).abs() <= 1.0);
         assert!(((t.gyro_energy_counts2 as f64).sqrt() - g).abs() <= 1.0);
         assert_eq!(t.window, 10);
+    }
+}
+
+#[test]
+fn stance_thresholds_match_physical_units() {
+    // Deflated units per (m/s²)²: 2048 · 8 / 9.80665².
+    let per = 2048.0 * 8.0 / (9.80665 * 9.80665);
+    for (hz, half) in [(100, [2, 3, 6]), (200, [3, 6, 12]), (1000, [15, 30, 60])] {
+        let t = StanceThresholds::new(SampleRate::from_hz(hz).unwrap(), GyroRange::Dps2000);
+        assert_eq!(t.half, half, "{hz} Hz");
+        let std = DEFLATED_STD_MAX as f64 / 1000.0 * per;
+        assert!(((t.variance as f64).sqrt() - std).abs() <= 1.0);
+        assert!((t.iqr as f64 - DEFLATED_IQR_MAX as f64 / 1000.0 * per).abs() <= 1.0);
+    }
+}
+
+#[test]
+fn deflate_is_the_signed_square_within_one_unit() {
+    for x in (i16::MIN..=i16::MAX)
+        .step_by(7)
+        .chain([i16::MIN, i16::MAX, 0, 1, -1])
+    {
+        let exact = x as f64 * (x as f64).abs() * 8.0 / 2048.0;
+        let got = deflate(x) as f64;
+        // Floor: error in [0, 1).
+        assert!((0.0..1.0).contains(&(exact - got)), "{x}: {exact} vs {got}");
+    }
+}
+
+#[test]
+fn foot_frame_rotation_matches_f64_within_one_unit() {
+    use gaitclip::foot_frame::FootFrameEstimator;
+    use gaitclip::sample::RawSample;
+    let mut r = rng();
+    for range in [AccelRange::G16, AccelRange::G2] {
+        for _ in 0..20 {
+            // A frame learnt from a rest in a random attitude.
+            let q = random_unit(&mut r);
+            let m = q
+                .matrix()
+                .map(|row| row.map(|v| v as f64 / (1u64 << 30) as f64));
+            let lsb = range.lsb_per_g() as f64;
+            let up_sensor = [m[2][0] * lsb, m[2][1] * lsb, m[2][2] * lsb];
+            let mut est = FootFrameEstimator::new(SampleRate::from_hz(200).unwrap(), range);
+            let rest = RawSample {
+                accel: up_sensor.map(|v| v.round() as i16),
+                gyro: [0; 3],
+                temp: 0,
+            };
+            for _ in 0..50 {
+                est.process(&rest, true);
+            }
+            est.process(&rest, false);
+            let f = est.frame().expect("frame after a rest");
+            let axes = f.axes(range);
+            for _ in 0..500 {
+                let a = [0; 3].map(|_| r.random::<i16>());
+                let got = f.apply(a);
+                for k in 0..3 {
+                    let dot: f64 = (0..3).map(|j| axes[k][j] as f64 * a[j] as f64).sum();
+                    let mut exact = dot * 2048.0 / lsb;
+                    if k == 2 {
+                        exact -= f.gravity() as f64;
+                    }
+                    let exact = exact.clamp(-32767.0, 32767.0);
+                    assert!(
+                        (got[k] as f64 - exact).abs() <= 1.0,
+                        "{range:?} axis {k}: {} vs {exact}",
+                        got[k]
+                    );
+                }
+            }
+            // Up is the rest's gravity direction; gravity is 1 g in foot units.
+            for j in 0..3 {
+                assert!((axes[2][j] as f64 - up_sensor[j] / lsb).abs() < 1e-3);
+            }
+            assert!((f.gravity() - 2048).abs() <= 1);
+        }
+    }
+}
+
+#[test]
+fn mean_filter_with_shorter_window() {
+    let mut r = rng();
+    let mut filt = MeanFilter::<16>::with_len_log2(2);
+    assert_eq!(filt.window(), 4);
+    assert_eq!(filt.delay(), 1);
+    let mut hist: Vec<[i16; 3]> = Vec::new();
+    for _ in 0..5_000 {
+        let x = [0; 3].map(|_| r.random::<i16>());
+        hist.push(x);
+        let y = filt.process(x);
+        let win = &hist[hist.len().saturating_sub(4)..];
+        for k in 0..3 {
+            let mean = win.iter().map(|v| v[k] as f64).sum::<f64>() / win.len() as f64;
+            assert!((0.0..1.0).contains(&(mean - y[k] as f64)));
+        }
     }
 }
 

@@ -4,10 +4,10 @@ use std::process::ExitCode;
 
 use anyhow::Context;
 use clap::{Parser, Subcommand};
-use gaitclip_host::trace::{Ranges, Trace};
 use gaitclip::phases::PhaseMethod;
 use gaitclip::pipeline::Config;
 use gaitclip_host::eval::{self, Detected};
+use gaitclip_host::trace::{Ranges, Trace};
 use gaitclip_host::{csv_trace, fixtures, mcap_io, replay};
 
 #[derive(Parser)]
