@@ -13,10 +13,14 @@
 //! 1. [`mpu6050`] — the driver: one burst read per sample into a [`sample::RawSample`] of
 //!    counts. Nothing later looks at a register.
 //! 2. [`mean_filter`] — a moving average over a power-of-two ring with a running sum.
-//! 3. [`stance`] — is the foot at rest? Variance of specific force and angular-rate energy
-//!    over a window, both orientation-free, against thresholds set in physical units.
-//! 4. [`stride`] — stance-to-stance segmentation, the gait events inside a stride, and
-//!    [`zupt`] strapdown integration with zero-velocity updates for its length.
+//! 3. [`foot_frame`] — which way is up (gravity in the rests that the orientation-free
+//!    [`rest`] test finds) and which way is forward (the axis the foot pitches about in its
+//!    steps); every sample is rotated into that frame by an integer matrix.
+//! 4. [`stance`] — is the foot flat? Huang's deflated variance and interquartile range of
+//!    vertical and sagittal acceleration over three windows, with angular-rate energy.
+//! 5. [`stride`] — stance-to-stance segmentation and its flags, Huang's [`phases`] splitter
+//!    for toe-off and heel-strike, and [`zupt`] strapdown integration with zero-velocity
+//!    updates for the length.
 //!
 //! [`pipeline::Pipeline`] composes them; a board or a host tool only feeds samples and
 //! reads strides.
@@ -27,7 +31,7 @@
 //! and on the host that replays recordings; tests compare the two.
 //!
 //! **No heap, no panics, bounded state.** Every buffer is a compile-time capacity
-//! ([`stance::WINDOW_CAPACITY`], [`pipeline::DELAY_CAPACITY`],
+//! ([`stance::RING_CAPACITY`], [`pipeline::DELAY_CAPACITY`],
 //! [`stride::MAX_MOVEMENT_SAMPLES`]); a movement longer than its buffer is flagged, never
 //! grown. Arithmetic that could overflow on hostile input saturates or is bounded by the
 //! capacities.
@@ -36,9 +40,10 @@
 //! `boards/` feeds samples from a sensor or a replayed trace and logs over defmt;
 //! `tests-host/` reads CSV and MCAP. The core forbids `unsafe`.
 //!
-//! **Orientation-free.** A clip is mounted however the user mounts it. Stance detection uses
-//! only magnitudes; the ZUPT integrator levels itself from gravity at every stance and
-//! measures horizontal distance, which does not depend on yaw.
+//! **Any mounting.** A clip is mounted however the user mounts it. The foot frame is learnt
+//! from the data and re-learnt when the clip moves; the ZUPT integrator levels itself from
+//! gravity at every stance and measures horizontal distance, which does not depend on yaw.
+//! `gaitclip eval --rotate N` shows the results do not change under random rotations.
 //!
 //! ## Units
 //!
