@@ -25,6 +25,7 @@
 use nalgebra::{Matrix3, SymmetricEigen, Vector3};
 
 use crate::rate::SampleRate;
+use crate::rest::RestSums;
 use crate::sample::{AccelRange, RawSample};
 
 /// A rest period whose gravity direction is further than this from the current up axis
@@ -47,8 +48,6 @@ const COS_REMOUNT: f32 = 0.906_307_8;
 const UP_SMOOTHING: f32 = 0.125;
 /// Weight kept by the medio-lateral axis sum at each new movement.
 const AXIS_MEMORY: f32 = 0.875;
-/// Rest sums are halved beyond this many samples (standing for hours stays bounded).
-const REST_SUM_HALVING_AT: u32 = 1 << 16;
 
 /// Rotation from sensor counts into the foot frame, Q14 with the range scaling folded in.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -115,9 +114,7 @@ pub struct FootFrameEstimator {
     left_sum: [f32; 3],
     heading_known: bool,
     was_rest: bool,
-    rest_accel: [i64; 3],
-    rest_gyro: [i64; 3],
-    rest_n: u32,
+    rest: RestSums,
     gyro_bias: [i32; 3],
     /// Σ ω ωᵀ over the movement: xx, yy, zz, xy, xz, yz (counts²).
     cov: [i64; 6],
@@ -140,9 +137,7 @@ impl FootFrameEstimator {
             left_sum: [0.0; 3],
             heading_known: false,
             was_rest: false,
-            rest_accel: [0; 3],
-            rest_gyro: [0; 3],
-            rest_n: 0,
+            rest: RestSums::new(),
             gyro_bias: [0; 3],
             cov: [0; 6],
             sum_w: [0; 3],
@@ -161,9 +156,7 @@ impl FootFrameEstimator {
         match (self.was_rest, rest) {
             (false, true) => {
                 self.end_movement();
-                self.rest_accel = [0; 3];
-                self.rest_gyro = [0; 3];
-                self.rest_n = 0;
+                self.rest = RestSums::new();
                 self.accumulate_rest(s);
             }
             (true, true) => self.accumulate_rest(s),
@@ -181,17 +174,8 @@ impl FootFrameEstimator {
     }
 
     fn accumulate_rest(&mut self, s: &RawSample) {
-        if self.rest_n >= REST_SUM_HALVING_AT {
-            self.rest_accel = self.rest_accel.map(|v| v / 2);
-            self.rest_gyro = self.rest_gyro.map(|v| v / 2);
-            self.rest_n /= 2;
-        }
-        for i in 0..3 {
-            self.rest_accel[i] += s.accel[i] as i64;
-            self.rest_gyro[i] += s.gyro[i] as i64;
-        }
-        self.rest_n += 1;
-        if self.frame.is_none() && self.rest_n == self.first_after {
+        self.rest.add(s);
+        if self.frame.is_none() && self.rest.count == self.first_after {
             self.end_rest();
         }
     }
@@ -227,14 +211,14 @@ impl FootFrameEstimator {
     }
 
     fn end_rest(&mut self) {
-        if self.rest_n == 0 {
+        if self.rest.count == 0 {
             return;
         }
-        let n = self.rest_n as f32;
-        let mean = self.rest_accel.map(|v| v as f32 / n);
+        let n = self.rest.count as f32;
+        let mean = self.rest.accel.map(|v| v as f32 / n);
         self.gyro_bias = [0, 1, 2].map(|i| {
-            let n = self.rest_n as i64;
-            ((self.rest_gyro[i] + n / 2).div_euclid(n)) as i32
+            let n = self.rest.count as i64;
+            ((self.rest.gyro[i] + n / 2).div_euclid(n)) as i32
         });
         let m = Vector3::from(mean);
         let g = m.norm();

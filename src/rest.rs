@@ -138,3 +138,50 @@ impl RestDetector {
         Some(still_accel && still_gyro)
     }
 }
+
+/// Sums of the raw samples of one still period (a rest, a stance): what gravity, the gyro
+/// bias and the levelling are computed from. Beyond [`RestSums::HALVING_AT`] samples all
+/// sums are halved, so that standing for hours stays bounded (sums < 2³² for `i16` input)
+/// while the mean is kept.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
+pub struct RestSums {
+    /// Σ accelerometer counts per axis.
+    pub accel: [i64; 3],
+    /// Σ gyroscope counts per axis.
+    pub gyro: [i64; 3],
+    /// Samples summed (after halvings).
+    pub count: u32,
+}
+
+impl RestSums {
+    /// Sample count at which the sums are halved.
+    pub const HALVING_AT: u32 = 1 << 16;
+
+    /// No samples.
+    pub const fn new() -> Self {
+        RestSums {
+            accel: [0; 3],
+            gyro: [0; 3],
+            count: 0,
+        }
+    }
+
+    /// Adds one sample.
+    pub fn add(&mut self, s: &crate::sample::RawSample) {
+        if self.count >= Self::HALVING_AT {
+            self.accel = self.accel.map(|v| v / 2);
+            self.gyro = self.gyro.map(|v| v / 2);
+            self.count /= 2;
+        }
+        for ((a, g), (&sa, &sg)) in self
+            .accel
+            .iter_mut()
+            .zip(self.gyro.iter_mut())
+            .zip(s.accel.iter().zip(s.gyro.iter()))
+        {
+            *a += sa as i64;
+            *g += sg as i64;
+        }
+        self.count += 1;
+    }
+}

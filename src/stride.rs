@@ -30,6 +30,7 @@ use heapless::Vec;
 
 use crate::phases::{self, PhaseMethod};
 use crate::rate::SampleRate;
+use crate::rest::RestSums;
 use crate::sample::{GyroRange, RawSample};
 use crate::zupt::ZuptIntegrator;
 
@@ -115,9 +116,7 @@ pub struct StrideTracker {
     zupt: ZuptIntegrator,
     stance_start: u32,
     heel_off: u32,
-    accel_sum: [i64; 3],
-    gyro_sum: [i64; 3],
-    stance_samples: u32,
+    stance_sums: RestSums,
     movement: Vec<[i16; 2], MAX_MOVEMENT_SAMPLES>,
     flags: u8,
     next_index: u32,
@@ -126,10 +125,6 @@ pub struct StrideTracker {
     /// The last closed stride, held until the stance after it ends.
     pending: Option<Stride>,
 }
-
-/// Stance accumulators are halved at this count so that standing for hours cannot overflow
-/// them (sums stay below 2³² for i16 inputs).
-const STANCE_SUM_HALVING_AT: u32 = 1 << 16;
 
 impl StrideTracker {
     /// A tracker for a sample rate and gyro range, splitting phases with `phase_method`.
@@ -141,9 +136,7 @@ impl StrideTracker {
             zupt: ZuptIntegrator::new(rate, gyro),
             stance_start: 0,
             heel_off: 0,
-            accel_sum: [0; 3],
-            gyro_sum: [0; 3],
-            stance_samples: 0,
+            stance_sums: RestSums::new(),
             movement: Vec::new(),
             flags: 0,
             next_index: 0,
@@ -170,9 +163,7 @@ impl StrideTracker {
     }
 
     fn clear_stance(&mut self) {
-        self.accel_sum = [0; 3];
-        self.gyro_sum = [0; 3];
-        self.stance_samples = 0;
+        self.stance_sums = RestSums::new();
     }
 
     /// Feeds sample number `index`: its raw values, its mean-filtered foot-frame
@@ -205,10 +196,7 @@ impl StrideTracker {
                 None
             }
             (State::Stance, false) => {
-                if self
-                    .zupt
-                    .start(self.accel_sum, self.gyro_sum, self.stance_samples)
-                {
+                if self.zupt.start(&self.stance_sums) {
                     self.state = State::Moving;
                     self.heel_off = index;
                     self.movement.clear();
@@ -242,16 +230,7 @@ impl StrideTracker {
     }
 
     fn accumulate_stance(&mut self, s: &RawSample) {
-        if self.stance_samples >= STANCE_SUM_HALVING_AT {
-            self.accel_sum = self.accel_sum.map(|v| v / 2);
-            self.gyro_sum = self.gyro_sum.map(|v| v / 2);
-            self.stance_samples /= 2;
-        }
-        for i in 0..3 {
-            self.accel_sum[i] += s.accel[i] as i64;
-            self.gyro_sum[i] += s.gyro[i] as i64;
-        }
-        self.stance_samples += 1;
+        self.stance_sums.add(s);
     }
 
     fn accumulate_movement(&mut self, s: &RawSample, foot: [i16; 3]) {

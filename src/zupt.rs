@@ -15,6 +15,7 @@
 
 use crate::fixed::{div_round_i128, isqrt_u64, QuatQ30};
 use crate::rate::SampleRate;
+use crate::rest::RestSums;
 use crate::sample::{GyroRange, RawSample};
 
 /// π · 2³².
@@ -65,9 +66,10 @@ impl ZuptIntegrator {
         }
     }
 
-    /// Starts a movement from rest. `accel_sum` and `gyro_sum` are sums of `count` stance
-    /// samples (counts). Returns `false` (and stays idle) if the accelerometer read zero.
-    pub fn start(&mut self, accel_sum: [i64; 3], gyro_sum: [i64; 3], count: u32) -> bool {
+    /// Starts a movement from the rest summed in `rest`. Returns `false` (and stays idle) if
+    /// the rest is empty or the accelerometer read zero.
+    pub fn start(&mut self, rest: &RestSums) -> bool {
+        let (accel_sum, gyro_sum, count) = (rest.accel, rest.gyro, rest.count);
         if count == 0 {
             return false;
         }

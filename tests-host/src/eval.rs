@@ -529,6 +529,11 @@ pub fn random_rotation(rng: &mut impl Rng) -> [[f64; 3]; 3] {
             break v.map(|x| x / n);
         }
     };
+    rotation_matrix(q)
+}
+
+/// The rotation matrix of a unit quaternion `[w, x, y, z]` (`v' = M·v`).
+pub fn rotation_matrix(q: [f64; 4]) -> [[f64; 3]; 3] {
     let [w, x, y, z] = q;
     [
         [

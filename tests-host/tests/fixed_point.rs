@@ -4,7 +4,7 @@
 use gaitclip::fixed::{isqrt_u64, mul_q30, QuatQ30, Q30_ONE};
 use gaitclip::mean_filter::MeanFilter;
 use gaitclip::rate::SampleRate;
-use gaitclip::rest::{RestThresholds, ACCEL_STD_MAX_MMPS2, GYRO_RMS_MAX_MRADPS};
+use gaitclip::rest::{RestSums, RestThresholds, ACCEL_STD_MAX_MMPS2, GYRO_RMS_MAX_MRADPS};
 use gaitclip::sample::{AccelRange, GyroRange, RawSample};
 use gaitclip::stance::{deflate, StanceThresholds, DEFLATED_IQR_MAX, DEFLATED_STD_MAX};
 use gaitclip::zupt::ZuptIntegrator;
@@ -66,24 +66,7 @@ fn quat_f64(q: QuatQ30) -> [f64; 4] {
 }
 
 fn rotate_f64(q: [f64; 4], v: [f64; 3]) -> [f64; 3] {
-    let [w, x, y, z] = q;
-    let m = [
-        [
-            1.0 - 2.0 * (y * y + z * z),
-            2.0 * (x * y - w * z),
-            2.0 * (x * z + w * y),
-        ],
-        [
-            2.0 * (x * y + w * z),
-            1.0 - 2.0 * (x * x + z * z),
-            2.0 * (y * z - w * x),
-        ],
-        [
-            2.0 * (x * z - w * y),
-            2.0 * (y * z + w * x),
-            1.0 - 2.0 * (x * x + y * y),
-        ],
-    ];
+    let m = gaitclip_host::eval::rotation_matrix(q);
     [0, 1, 2].map(|i| (0..3).map(|k| m[i][k] * v[k]).sum())
 }
 
@@ -401,11 +384,10 @@ fn zupt_displacement_matches_f64_reference_within_1mm() {
         let stance = &counts[heel_off - 20..heel_off];
         let movement = &counts[heel_off..end];
         let mut z = ZuptIntegrator::new(rate, GyroRange::Dps2000);
-        let (sa, sg) = (
-            [0, 1, 2].map(|k| stance.iter().map(|s| s.accel[k] as i64).sum::<i64>()),
-            [0, 1, 2].map(|k| stance.iter().map(|s| s.gyro[k] as i64).sum::<i64>()),
-        );
-        assert!(z.start(sa, sg, stance.len() as u32));
+        let mut sums = RestSums::new();
+        stance.iter().for_each(|s| sums.add(s));
+        assert_eq!(sums.count as usize, stance.len());
+        assert!(z.start(&sums));
         movement.iter().for_each(|s| z.process(s));
         let d = z.displacement();
         let (h, v) = zupt_f64(stance, movement, 200.0);
