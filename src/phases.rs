@@ -92,10 +92,16 @@ impl Pair {
 const VERTICAL: u8 = 0;
 const SAGITTAL: u8 = 1;
 
-/// Splits one movement. `movement[i] = [vertical, sagittal]` (g/2048); `merge_samples` is
+/// Splits one movement. `movement[i] = [vertical, sagittal, …]` (g/2048; columns after
+/// the second are ignored); `merge_samples` is
 /// [`MERGE_MS`] at the sample rate. Never panics; a movement of fewer than 3 samples or
 /// without extremes gives its quarter and three-quarter points with `found = false`.
-pub fn split(movement: &[[i16; 2]], method: PhaseMethod, merge_samples: u32) -> PhaseSplit {
+pub fn split<const N: usize>(
+    movement: &[[i16; N]],
+    method: PhaseMethod,
+    merge_samples: u32,
+) -> PhaseSplit {
+    const { assert!(N >= 2, "a movement has vertical and sagittal columns") };
     let len = movement.len() as u32;
     let fallback = PhaseSplit {
         toe_off: len / 4,
@@ -175,7 +181,7 @@ pub fn split(movement: &[[i16; 2]], method: PhaseMethod, merge_samples: u32) -> 
     }
 }
 
-fn find_extremes(movement: &[[i16; 2]]) -> Vec<Extreme, MAX_EXTREMES> {
+fn find_extremes<const N: usize>(movement: &[[i16; N]]) -> Vec<Extreme, MAX_EXTREMES> {
     let min = MIN_EXTREME_MG * crate::foot_frame::FOOT_LSB_PER_G / 1000;
     let mut out = Vec::new();
     let len = movement.len();
@@ -280,8 +286,8 @@ fn major_pair<'a>(extremes: impl Iterator<Item = &'a Extreme> + Clone, merge: u3
 
 /// The sample where the derivative of `axis` crosses zero downward (a peak) or upward
 /// (a valley), nearest the centre of `pair`. The derivative is the central difference.
-fn nearest_derivative_crossing(
-    movement: &[[i16; 2]],
+fn nearest_derivative_crossing<const N: usize>(
+    movement: &[[i16; N]],
     axis: u8,
     downward: bool,
     pair: Pair,

@@ -4,15 +4,18 @@
 //! raw sample ─┬─ mean filter ─┬─ rest test ─→ foot-frame estimator ─┐ (frame)
 //!             │               └──────────── rotate into the foot frame ─→ stance detector
 //!             └─ delay line ───────────────────────────────────────────→ stride tracker
-//!                                                      (phases, ZUPT length, flags)
+//!                                  (phases, ZUPT displacement, phase stats, flags)
+//!                                                   stride ─→ features ─→ length model
 //! ```
 //!
 //! Each stage is fed only the records of the stage before it. The delays of the centred
 //! windows are undone by delay lines, so that every stride index is the number of the raw
 //! sample it names.
 
+use crate::features::Features;
 use crate::foot_frame::FootFrameEstimator;
 use crate::mean_filter::MeanFilter;
+use crate::models::{self, Model, ModelParams, Settings};
 use crate::phases::PhaseMethod;
 use crate::rate::SampleRate;
 use crate::rest::{RestDetector, RestThresholds};
@@ -29,6 +32,10 @@ pub const MEAN_FILTER_MS: u32 = 20;
 /// (centred) stance decision: ≥ stance delay (63) + filter delay (7) + 1.
 pub const DELAY_CAPACITY: usize = 128;
 
+/// The model the firmware ships with as its stride length (see the README's length
+/// table for why).
+pub const DEFAULT_MODEL: Model = Model::HuangSvrFusion;
+
 /// What the pipeline needs to know about the data.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct Config {
@@ -40,17 +47,27 @@ pub struct Config {
     pub gyro: GyroRange,
     /// Phase splitter version.
     pub phases: PhaseMethod,
+    /// The model that fills in [`Stride::length_mm`].
+    pub model: Model,
+    /// Device settings of the models (the wearer's height).
+    pub settings: Settings,
+    /// Trained coefficients and SVRs.
+    pub params: &'static ModelParams<'static>,
 }
 
 impl Config {
     /// The default configuration for data at `rate` in the given ranges: the augmented
-    /// phase splitter.
+    /// phase splitter, the [`DEFAULT_MODEL`] with the shipped [`crate::trained::PARAMS`],
+    /// and the default height.
     pub const fn new(rate: SampleRate, accel: AccelRange, gyro: GyroRange) -> Self {
         Config {
             rate,
             accel,
             gyro,
             phases: PhaseMethod::Augmented,
+            model: DEFAULT_MODEL,
+            settings: Settings::DEFAULT,
+            params: &crate::trained::PARAMS,
         }
     }
 }
@@ -76,6 +93,10 @@ pub struct Pipeline {
     frame: FootFrameEstimator,
     stance: StanceDetector,
     tracker: StrideTracker,
+    rate: SampleRate,
+    model: Model,
+    settings: Settings,
+    params: &'static ModelParams<'static>,
     raw_line: [RawSample; DELAY_CAPACITY],
     foot_line: [[i16; 3]; DELAY_CAPACITY],
     /// Samples between an input and the raw sample the rest decision is about.
@@ -106,6 +127,10 @@ impl Pipeline {
             frame: FootFrameEstimator::new(config.rate, config.accel),
             stance,
             tracker: StrideTracker::new(config.rate, config.gyro, config.phases),
+            rate: config.rate,
+            model: config.model,
+            settings: config.settings,
+            params: config.params,
             raw_line: [RawSample {
                 accel: [0; 3],
                 gyro: [0; 3],
@@ -164,7 +189,8 @@ impl Pipeline {
         let at = index.wrapping_sub(self.delay);
         let foot_at = index.wrapping_sub(self.stance.delay());
         let (raw, foot) = (self.raw_line[slot(at)], self.foot_line[slot(foot_at)]);
-        self.tracker.process(at, &raw, foot, decision)
+        let stride = self.tracker.process(at, &raw, foot, decision);
+        stride.map(|s| self.measure(s))
     }
 
     /// Declares `missing` samples lost (FIFO overflow, a jump in timestamps): the movement
@@ -177,7 +203,8 @@ impl Pipeline {
         self.filter = MeanFilter::with_len_log2(self.filter.window().trailing_zeros());
         self.rest.reset();
         self.stance.reset();
-        self.tracker.reset()
+        let stride = self.tracker.reset();
+        stride.map(|s| self.measure(s))
     }
 
     /// Drains the samples still in the delay line at the end of a recording, with the last
@@ -199,12 +226,22 @@ impl Pipeline {
             let foot_at = at.wrapping_add(fd);
             let (raw, foot) = (self.raw_line[slot(at)], self.foot_line[slot(foot_at)]);
             if let Some(st) = self.tracker.process(at, &raw, foot, self.last_decision) {
-                out[0] = Some(st);
+                out[0] = Some(self.measure(st));
             }
         }
-        out[1] = self.tracker.finish();
+        out[1] = self.tracker.finish().map(|s| self.measure(s));
         self.since_reset = 0;
         self.stance_fed = 0;
         out
+    }
+
+    /// Fills in the stride's length from the configured model; a malformed trained model
+    /// falls back to the ZUPT displacement, which needs no training.
+    fn measure(&self, mut s: Stride) -> Stride {
+        let f = Features::of(&s, self.rate);
+        s.length_mm = models::predict_mm(self.model, &f, self.settings, self.params)
+            .or_else(|| models::predict_mm(Model::Zupt, &f, self.settings, self.params))
+            .unwrap_or(0);
+        s
     }
 }

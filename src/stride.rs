@@ -9,8 +9,9 @@
 //!
 //! Heel-off and foot-flat are the edges of the stances ([`crate::stance`]); toe-off and
 //! heel-strike come from Huang's splitter ([`crate::phases`]) run on the movement's
-//! foot-frame acceleration; the length is the ZUPT displacement of the movement
-//! ([`crate::zupt`]).
+//! foot-frame acceleration. A stride carries what the length models need: the ZUPT
+//! displacement of the movement ([`crate::zupt`]) and integer summaries of its acceleration
+//! phase by phase ([`crate::phase_stats`]); the pipeline fills in the length.
 //!
 //! **What is and is not a stride.** A movement shorter than [`MIN_MOVEMENT_MS`] is a wobble
 //! of a foot on the ground and merges into the stance; standing still therefore yields no
@@ -28,14 +29,18 @@
 
 use heapless::Vec;
 
+use crate::fixed::isqrt_u64;
+use crate::foot_frame::FOOT_LSB_PER_G;
+use crate::phase_stats::{StrideStats, CHANNELS};
 use crate::phases::{self, PhaseMethod};
 use crate::rate::SampleRate;
 use crate::rest::RestSums;
 use crate::sample::{GyroRange, RawSample};
 use crate::zupt::ZuptIntegrator;
 
-/// Capacity of the movement buffer: 2.048 s at 1 kHz, 20 s at 100 Hz.
-pub const MAX_MOVEMENT_SAMPLES: usize = 2048;
+/// Capacity of the movement buffer: 1.024 s at 1 kHz, 5 s at 204.8 Hz, 10 s at 100 Hz
+/// (a walking movement, heel-off to foot-flat, lasts 0.5–1 s).
+pub const MAX_MOVEMENT_SAMPLES: usize = 1024;
 /// A movement shorter than this is a wobble of a foot still on the ground, not a step.
 pub const MIN_MOVEMENT_MS: u32 = 150;
 /// At most this much of a stance counts toward the stride that leaves it: a user who stood
@@ -91,12 +96,17 @@ pub struct Stride {
     pub heel_strike: u32,
     /// Foot-flat ending the stride (the next stride's start); exclusive end.
     pub end: u32,
-    /// Horizontal length of the stride, mm.
+    /// Length of the stride, mm, from the pipeline's length model
+    /// ([`crate::models`]); 0 until the pipeline sets it.
     pub length_mm: u32,
+    /// Horizontal ZUPT displacement over the movement, µm (saturates at 4.29 km).
+    pub zupt_um: u32,
     /// Height gained over the stride, mm (stairs, slopes).
     pub climb_mm: i32,
     /// Qualifiers.
     pub flags: StrideFlags,
+    /// The movement's acceleration summarised phase by phase, for the features.
+    pub stats: StrideStats,
 }
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -117,7 +127,7 @@ pub struct StrideTracker {
     stance_start: u32,
     heel_off: u32,
     stance_sums: RestSums,
-    movement: Vec<[i16; 2], MAX_MOVEMENT_SAMPLES>,
+    movement: Vec<[i16; CHANNELS], MAX_MOVEMENT_SAMPLES>,
     flags: u8,
     next_index: u32,
     phase_method: PhaseMethod,
@@ -235,7 +245,11 @@ impl StrideTracker {
 
     fn accumulate_movement(&mut self, s: &RawSample, foot: [i16; 3]) {
         self.zupt.process(s);
-        if self.movement.push([foot[2], foot[0]]).is_err() {
+        if self
+            .movement
+            .push([foot[2], foot[0], magnitude_minus_g(foot)])
+            .is_err()
+        {
             self.flags |= StrideFlags::TOO_LONG;
         }
         if s.is_saturated() {
@@ -260,6 +274,7 @@ impl StrideTracker {
             self.stance_start
         };
         let d = self.zupt.displacement();
+        let stats = StrideStats::measure(&self.movement, split.toe_off, split.heel_strike);
         let index = self.next_index;
         self.next_index = self.next_index.wrapping_add(1);
         Stride {
@@ -269,10 +284,21 @@ impl StrideTracker {
             toe_off: self.heel_off.wrapping_add(split.toe_off),
             heel_strike: self.heel_off.wrapping_add(split.heel_strike),
             end: foot_flat,
-            length_mm: ((d.horizontal_um + 500) / 1000).min(u32::MAX as u64) as u32,
+            length_mm: 0,
+            zupt_um: d.horizontal_um.min(u32::MAX as u64) as u32,
             climb_mm: ((d.vertical_um + 500).div_euclid(1000))
                 .clamp(i32::MIN as i64, i32::MAX as i64) as i32,
             flags: StrideFlags(flags),
+            stats,
         }
     }
+}
+
+/// `|f| − g` of a foot-frame sample `[forward, left, up − g]` (g/2048), in g/2048,
+/// saturated to `i16`: the orientation-free magnitude channel of [`crate::phase_stats`].
+fn magnitude_minus_g(foot: [i16; 3]) -> i16 {
+    let up = foot[2] as i64 + FOOT_LSB_PER_G as i64;
+    let m2 = (foot[0] as i64).pow(2) + (foot[1] as i64).pow(2) + up * up;
+    let m = isqrt_u64(m2 as u64) as i64 - FOOT_LSB_PER_G as i64;
+    m.clamp(i16::MIN as i64, i16::MAX as i64) as i16
 }
