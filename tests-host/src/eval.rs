@@ -62,7 +62,7 @@ impl From<&gaitclip::stride::Stride> for Detected {
 }
 
 /// One reference stride.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Reference {
     /// Interval that contains the stride's movement.
     pub start: u32,
@@ -76,6 +76,8 @@ pub struct Reference {
     pub heel_strike: Option<u32>,
     /// Heel-strike that began the stride's ground contact, where labelled.
     pub prev_heel_strike: Option<u32>,
+    /// Reference stride length, m, where the dataset has one.
+    pub length_m: Option<f64>,
 }
 
 /// One recording and its ground truth.
@@ -91,6 +93,10 @@ pub struct Trial {
     pub span: (u32, u32),
     /// Per-sample stance label, where the dataset has one.
     pub stance: Option<Vec<bool>>,
+    /// The walker's height, m, where the dataset gives it.
+    pub height_m: Option<f64>,
+    /// Distance walked over `span`, m, where the dataset gives it (not per stride).
+    pub distance_m: Option<f64>,
 }
 
 /// A dataset folder.
@@ -168,6 +174,12 @@ fn load_strides(dir: &Path, name: &str) -> Result<Vec<Trial>> {
             toe_off: opt("tc_idx")?,
             heel_strike: opt("ic_idx")?,
             prev_heel_strike: opt("pre_ic_idx")?,
+            length_m: Some(
+                field(&row, "length_m", &path)?
+                    .trim()
+                    .parse()
+                    .with_context(|| format!("{}: length_m is not a number", path.display()))?,
+            ),
         };
         by_trial
             .entry(field(&row, "trial", &path)?.to_string())
@@ -196,6 +208,8 @@ fn load_strides(dir: &Path, name: &str) -> Result<Vec<Trial>> {
             references,
             span,
             stance,
+            height_m: None,
+            distance_m: None,
         });
     }
     Ok(trials)
@@ -204,12 +218,26 @@ fn load_strides(dir: &Path, name: &str) -> Result<Vec<Trial>> {
 fn load_ipol(dir: &Path) -> Result<Vec<Trial>> {
     let tpath = dir.join("trials.csv");
     let mut spans = BTreeMap::new();
+    let number = |row: &BTreeMap<String, String>, k: &str| -> Result<f64> {
+        let v = field(row, k, &tpath)?;
+        v.trim()
+            .parse()
+            .with_context(|| format!("{}: `{k}` = {v:?} is not a number", tpath.display()))
+    };
     for row in read_rows(&tpath)? {
         spans.insert(
             field(&row, "trial", &tpath)?.to_string(),
             (
-                index(&row, "walk_start_idx", &tpath)?,
-                index(&row, "walk_end_idx", &tpath)?,
+                (
+                    index(&row, "walk_start_idx", &tpath)?,
+                    index(&row, "walk_end_idx", &tpath)?,
+                ),
+                // Some subjects' heights are not given: left empty.
+                match field(&row, "height_m", &tpath)?.trim() {
+                    "" => None,
+                    _ => Some(number(&row, "height_m")?),
+                },
+                number(&row, "distance_m")?,
             ),
         );
     }
@@ -225,6 +253,7 @@ fn load_ipol(dir: &Path) -> Result<Vec<Trial>> {
             toe_off: Some(to),
             heel_strike: Some(hs),
             prev_heel_strike: None,
+            length_m: None,
         };
         let key = (
             field(&row, "trial", &epath)?.to_string(),
@@ -242,7 +271,7 @@ fn load_ipol(dir: &Path) -> Result<Vec<Trial>> {
         for k in 1..references.len() {
             references[k].prev_heel_strike = references[k - 1].heel_strike;
         }
-        let span = *spans
+        let (span, height, distance) = *spans
             .get(&trial)
             .with_context(|| format!("{}: no trial {trial}", tpath.display()))?;
         trials.push(Trial {
@@ -251,6 +280,8 @@ fn load_ipol(dir: &Path) -> Result<Vec<Trial>> {
             references,
             span,
             stance: None,
+            height_m: height,
+            distance_m: Some(distance),
         });
     }
     Ok(trials)

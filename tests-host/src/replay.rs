@@ -1,6 +1,10 @@
 //! Runs a trace through the firmware core, exactly as the board does, and reports strides
 //! in the trace's own clock.
 
+use std::collections::BTreeMap;
+
+use gaitclip::features::Features;
+use gaitclip::models::{self, Model};
 use gaitclip::pipeline::{Config, Pipeline};
 use gaitclip::rate::SampleRate;
 use gaitclip::sample::RawSample;
@@ -26,8 +30,15 @@ pub struct StrideReport {
     pub start_s: f64,
     /// End (next foot-flat), s.
     pub end_s: f64,
-    /// Length from the default model, m.
+    /// Length from the pipeline's model (the default unless `--model` chose one), m.
     pub length_m: f64,
+    /// Name of the model behind `length_m`.
+    pub model: &'static str,
+    /// Every model's length, m, by model name (`--all-models`).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub lengths_m: Option<BTreeMap<&'static str, f64>>,
+    /// The ZUPT displacement, m.
+    pub zupt_m: f64,
     /// Heel-off (end of stance), s.
     pub heel_off_s: f64,
     /// Toe-off, s.
@@ -99,12 +110,23 @@ pub fn replay_counts_with(
 ) -> Vec<StrideReport> {
     core_strides(samples, config)
         .into_iter()
-        .map(|s| report(s, &t_s))
+        .map(|s| report(s, config.model, &t_s))
         .collect()
 }
 
-/// Replays a trace in physical units: converts to counts at `ranges` (with saturation) first.
+/// Replays a trace in physical units with the default model.
 pub fn replay(trace: &Trace, ranges: Ranges) -> Result<Vec<StrideReport>, ReplayError> {
+    replay_model(trace, ranges, gaitclip::pipeline::DEFAULT_MODEL, false)
+}
+
+/// Replays a trace in physical units: converts to counts at `ranges` (with saturation)
+/// first; `model` gives `length_m`, and with `all_models` every model's length is added.
+pub fn replay_model(
+    trace: &Trace,
+    ranges: Ranges,
+    model: Model,
+    all_models: bool,
+) -> Result<Vec<StrideReport>, ReplayError> {
     let rate = trace
         .sample_rate()
         .ok_or(ReplayError::Rate(trace.rate_hz))?;
@@ -116,15 +138,35 @@ pub fn replay(trace: &Trace, ranges: Ranges) -> Result<Vec<StrideReport>, Replay
         // Past the end (cannot happen for events, which lie on fed samples): extrapolate.
         None => times.last().copied().unwrap_or(0.0) + dt * (i as f64 - times.len() as f64 + 1.0),
     };
-    Ok(replay_counts(&counts, rate, ranges, t_s))
+    let mut config = Config::new(rate, ranges.accel, ranges.gyro);
+    config.model = model;
+    let mut out = replay_counts_with(&counts, config, t_s);
+    if all_models {
+        for r in &mut out {
+            let f = Features::of(&r.raw, rate);
+            r.lengths_m = Some(
+                Model::ALL
+                    .iter()
+                    .map(|&m| {
+                        let mm = models::predict_mm(m, &f, config.settings, config.params);
+                        (m.name(), mm.unwrap_or(0) as f64 / 1000.0)
+                    })
+                    .collect(),
+            );
+        }
+    }
+    Ok(out)
 }
 
-fn report(s: Stride, t_s: &impl Fn(u32) -> f64) -> StrideReport {
+fn report(s: Stride, model: Model, t_s: &impl Fn(u32) -> f64) -> StrideReport {
     StrideReport {
         index: s.index,
         start_s: t_s(s.start),
         end_s: t_s(s.end),
         length_m: s.length_mm as f64 / 1000.0,
+        model: model.name(),
+        lengths_m: None,
+        zupt_m: s.zupt_um as f64 / 1e6,
         heel_off_s: t_s(s.heel_off),
         toe_off_s: t_s(s.toe_off),
         heel_strike_s: t_s(s.heel_strike),

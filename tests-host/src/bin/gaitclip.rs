@@ -4,11 +4,12 @@ use std::process::ExitCode;
 
 use anyhow::Context;
 use clap::{Parser, Subcommand};
+use gaitclip::models::Model;
 use gaitclip::phases::PhaseMethod;
 use gaitclip::pipeline::Config;
 use gaitclip_host::eval::{self, Detected};
 use gaitclip_host::trace::{Ranges, Trace};
-use gaitclip_host::{csv_trace, fixtures, mcap_io, replay};
+use gaitclip_host::{csv_trace, fixtures, length_eval, mcap_io, replay, train};
 
 #[derive(Parser)]
 #[command(
@@ -33,6 +34,12 @@ enum Cmd {
         /// One JSON object per stride per line.
         #[arg(long)]
         json: bool,
+        /// Length model for `length_m` (default: the firmware's).
+        #[arg(long, value_name = "NAME", value_parser = model_names(), default_value = gaitclip::pipeline::DEFAULT_MODEL.name())]
+        model: String,
+        /// Add every model's length (`lengths_m` in JSON, a column each otherwise).
+        #[arg(long)]
+        all_models: bool,
         /// Also write the samples and the strides to this MCAP file (opens in Foxglove).
         #[arg(long, value_name = "FILE")]
         mcap_out: Option<PathBuf>,
@@ -52,6 +59,20 @@ enum Cmd {
         /// Phase splitter: Huang's major peak-valley pairs or the augmented version.
         #[arg(long, value_enum, default_value_t = PhasesArg::Augmented)]
         phases: PhasesArg,
+        /// Write the default model's Bland–Altman plot and predicted-vs-reference scatter
+        /// (SVG) into this folder.
+        #[arg(long, value_name = "DIR")]
+        plots: Option<PathBuf>,
+    },
+    /// Train every stride-length model on the shared datasets with per-stride lengths and
+    /// write the generated Rust source the firmware compiles.
+    Train {
+        /// The folder holding the datasets (`../shared/datasets`).
+        #[arg(default_value = "../../shared/datasets")]
+        datasets: PathBuf,
+        /// Output file.
+        #[arg(long, default_value = "../src/trained.rs")]
+        out: PathBuf,
     },
     /// Regenerate the simulated fixtures (traces with ground truth) into a folder.
     Simulate {
@@ -74,6 +95,10 @@ impl From<PhasesArg> for PhaseMethod {
             PhasesArg::Augmented => PhaseMethod::Augmented,
         }
     }
+}
+
+fn model_names() -> clap::builder::PossibleValuesParser {
+    clap::builder::PossibleValuesParser::new(Model::ALL.map(|m| m.name()))
 }
 
 fn main() -> ExitCode {
@@ -104,10 +129,13 @@ fn run(cli: Cli) -> anyhow::Result<()> {
             trace,
             rate,
             json,
+            model,
+            all_models,
             mcap_out,
         } => {
             let t = read_trace(&trace, rate)?;
-            let strides = replay::replay(&t, Ranges::default())?;
+            let model = Model::from_name(&model).context("unknown model")?;
+            let strides = replay::replay_model(&t, Ranges::default(), model, all_models)?;
             for s in &strides {
                 if json {
                     println!("{}", serde_json::to_string(s)?);
@@ -124,6 +152,11 @@ fn run(cli: Cli) -> anyhow::Result<()> {
                         (s.end_s - s.heel_strike_s) * 1e3,
                         if s.valid { String::new() } else { format!("  INVALID ({})", s.flags.join(",")) }
                     );
+                    if let Some(all) = &s.lengths_m {
+                        let cols: Vec<String> =
+                            all.iter().map(|(k, v)| format!("{k} {v:.3}")).collect();
+                        println!("           {}", cols.join("  "));
+                    }
                 }
             }
             let total: f64 = strides.iter().map(|s| s.length_m).sum();
@@ -140,6 +173,7 @@ fn run(cli: Cli) -> anyhow::Result<()> {
             rotate,
             seed,
             phases,
+            plots,
         } => {
             let detector = |t: &Trace, r: Ranges| -> anyhow::Result<Vec<Detected>> {
                 let rate = t
@@ -154,11 +188,43 @@ fn run(cli: Cli) -> anyhow::Result<()> {
                     .collect())
             };
             let mut results = Vec::new();
+            let mut runs = Vec::new();
             for dir in &datasets {
                 let d = eval::load(dir)?;
                 results.push(eval::evaluate(&d, &detector, rotate, seed)?);
+                runs.extend(train::run_dataset(&d)?);
             }
             print!("{}", eval::table(&results));
+            let hyper = train::hyper_from(&gaitclip::trained::HYPER);
+            let (pred, _) = length_eval::cross_validate(&runs, &hyper)?;
+            println!();
+            print!("{}", length_eval::table(&length_eval::score(&runs, &pred)));
+            if let Some(dir) = plots {
+                let model = gaitclip::pipeline::DEFAULT_MODEL;
+                let pairs = length_eval::pairs(&runs, &pred, model);
+                if !pairs.is_empty() {
+                    let (ba, sc) = length_eval::plots(&pairs, model.name());
+                    std::fs::create_dir_all(&dir)?;
+                    for (name, svg) in [("bland_altman.svg", ba), ("scatter.svg", sc)] {
+                        let p = dir.join(name);
+                        std::fs::write(&p, svg)
+                            .with_context(|| format!("writing {}", p.display()))?;
+                        eprintln!("wrote {}", p.display());
+                    }
+                }
+            }
+        }
+        Cmd::Train { datasets, out } => {
+            let runs = train::load_training(&datasets)?;
+            let t = train::train(&runs)?;
+            std::fs::write(&out, train::rust_source(&t))
+                .with_context(|| format!("writing {}", out.display()))?;
+            eprintln!(
+                "trained on {} strides of {} trials; wrote {}",
+                t.trained.samples,
+                t.trials,
+                out.display()
+            );
         }
         Cmd::Simulate { out } => {
             fixtures::write_all(&out)?;
