@@ -19,8 +19,12 @@
 //! 4. [`stance`] — is the foot flat? Huang's deflated variance and interquartile range of
 //!    vertical and sagittal acceleration over three windows, with angular-rate energy.
 //! 5. [`stride`] — stance-to-stance segmentation and its flags, Huang's [`phases`] splitter
-//!    for toe-off and heel-strike, and [`zupt`] strapdown integration with zero-velocity
-//!    updates for the length.
+//!    for toe-off and heel-strike, [`zupt`] strapdown integration with zero-velocity
+//!    updates, and [`phase_stats`], the movement's acceleration summed phase by phase.
+//! 6. [`features`] — Huang's per-phase features (Table 2) in Q16.
+//! 7. [`models`] — every paper's stride-length model side by side ([`fuzzy`] for Lu's K,
+//!    [`svr`] for Huang's RBF SVRs), with the coefficients and support vectors that
+//!    `gaitclip train` writes into [`trained`]; the pipeline's model fills in the length.
 //!
 //! [`pipeline::Pipeline`] composes them; a board or a host tool only feeds samples and
 //! reads strides.
