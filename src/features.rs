@@ -105,15 +105,6 @@ pub const fn frequency_index(segment: Segment) -> usize {
     duration_index(segment) + 1
 }
 
-/// The segment a feature index belongs to, if any (the two stride-wide ones have none).
-pub const fn segment_of(i: usize) -> Option<Segment> {
-    if i >= STRIDE_FREQUENCY {
-        None
-    } else {
-        Some(Segment::ALL[i / PER_SEGMENT])
-    }
-}
-
 /// The name of feature `i`, as `(segment, channel, stat)`; stride-wide features and the
 /// per-segment duration and frequency leave the parts they lack empty.
 pub const fn name_parts(i: usize) -> (&'static str, &'static str, &'static str) {

@@ -620,18 +620,15 @@ pub fn fit_all(train: &[&Sample], hyper: &HyperSet) -> Result<Trained> {
     }
     let lu = lu_range(train);
     let linear = fit_linear(train, lu)?;
+    // One feature selection per slot, shared by its SVR and its boosted ensemble.
+    let inputs: Vec<Vec<usize>> = SLOTS.iter().map(|&seg| select(train, seg)).collect();
     let mut svrs = Vec::new();
-    for (k, seg) in SLOTS.iter().enumerate() {
-        svrs.push(fit_svr(train, &select(train, *seg), hyper[k])?);
+    for (k, f) in inputs.iter().enumerate() {
+        svrs.push(fit_svr(train, f, hyper[k])?);
     }
     let mut boosted = Vec::new();
-    for k in 0..3 {
-        boosted.push(fit_boosted(
-            train,
-            &select(train, SLOTS[k]),
-            hyper[k],
-            SEED + k as u64,
-        )?);
+    for (k, f) in inputs.iter().take(3).enumerate() {
+        boosted.push(fit_boosted(train, f, hyper[k], SEED + k as u64)?);
     }
     let whole = svrs.pop().context("whole")?;
     let fusion: [SvrF64; 3] = svrs.try_into().map_err(|_| anyhow::anyhow!("fusion"))?;
