@@ -162,6 +162,20 @@ pub struct ModelParams<'a> {
     pub adaboost: [Boosted<'a>; 3],
 }
 
+impl ModelParams<'_> {
+    /// True when this build carries what `model` needs. The SVR models other than the
+    /// pipeline's default are only in builds with the `all-models` feature (they are
+    /// 300 KiB of tables); the closed-form models and ZUPT are always there.
+    pub fn ships(&self, model: Model) -> bool {
+        match model {
+            Model::HuangSvrFusion => self.fusion.iter().all(Svr::is_present),
+            Model::HuangSvrWhole => self.whole.is_present(),
+            Model::HuangSvrAdaBoost => self.adaboost.iter().all(Boosted::is_present),
+            _ => true,
+        }
+    }
+}
+
 /// The basis terms, Q16, of a closed-form model: its length is `Σ cᵢ·termᵢ`. `None` for
 /// ZUPT and the SVRs. Units per term are in the module table.
 pub fn basis(

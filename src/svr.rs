@@ -46,7 +46,26 @@ pub struct Svr<'a> {
     pub rho_nm: i64,
 }
 
+impl Svr<'static> {
+    /// A model that is not in this build (the firmware was built without the
+    /// `all-models` feature): it predicts nothing.
+    pub const ABSENT: Svr<'static> = Svr {
+        features: &[],
+        mean_q16: &[],
+        inv_std_q32: &[],
+        gamma_q32: 0,
+        support_q16: &[],
+        alpha_nm: &[],
+        rho_nm: 0,
+    };
+}
+
 impl Svr<'_> {
+    /// True when the model has support vectors, i.e. it was trained and shipped.
+    pub const fn is_present(&self) -> bool {
+        !self.features.is_empty() && !self.alpha_nm.is_empty()
+    }
+
     /// The z-scores of the inputs, Q16; `None` if the model is malformed (more than
     /// [`MAX_FEATURES`] inputs, or tables of mismatched lengths).
     fn inputs(&self, f: &Features) -> Option<[i64; MAX_FEATURES]> {
@@ -96,7 +115,20 @@ pub struct Boosted<'a> {
     pub weights_q16: &'a [u32],
 }
 
+impl Boosted<'static> {
+    /// An ensemble that is not in this build (see [`Svr::ABSENT`]).
+    pub const ABSENT: Boosted<'static> = Boosted {
+        members: &[],
+        weights_q16: &[],
+    };
+}
+
 impl Boosted<'_> {
+    /// True when every member is present.
+    pub fn is_present(&self) -> bool {
+        !self.members.is_empty() && self.members.iter().all(Svr::is_present)
+    }
+
     /// The weighted median of the members' predictions for `f`, nm; `None` if empty or
     /// malformed.
     pub fn predict_nm(&self, f: &Features) -> Option<i64> {

@@ -2090,18 +2090,22 @@ static FUSION_HEEL_STRIKE_ALPHA_NM: [i64; 650] = [
     675248649, 1000000000, 1000000000, -431348577, 1000000000, 1000000000, -1000000000, -1000000000,
     -1000000000, -1000000000,
 ];
+#[cfg(feature = "all-models")]
 static WHOLE_FEATURES: [u8; 9] = [
     100 /* movement.mag.kim */, 91 /* movement.sag.weinberg */, 84 /* movement.vert.kim */, 92 /* movement.sag.kim */, 97 /* movement.mag.mean_abs */, 88 /* movement.sag.range */, 89 /* movement.sag.mean_abs */, 81 /* movement.vert.mean_abs */,
     105 /* stride..zupt_length */,
 ];
+#[cfg(feature = "all-models")]
 static WHOLE_MEAN_Q16: [i64; 9] = [
     56325, 89919, 48944, 55330, 45619, 258138, 42024, 28938,
     79860,
 ];
+#[cfg(feature = "all-models")]
 static WHOLE_INV_STD_Q32: [i64; 9] = [
     27705163370, 22331165135, 40464060559, 33909673929, 12394510353, 2265512256, 16576235326, 24039520949,
     6725479472,
 ];
+#[cfg(feature = "all-models")]
 static WHOLE_SUPPORT_Q16: [i32; 2889] = [
     64406, 63800, 110688, 50882, 64254, 68196, 49647, 129387,
     17928, 56116, 54946, 102292, 42403, 53083, 54912, 38791,
@@ -2466,6 +2470,7 @@ static WHOLE_SUPPORT_Q16: [i32; 2889] = [
     -100880, -79690, -122302, -72898, -86394, -78148, -74169, -101356,
     -72099,
 ];
+#[cfg(feature = "all-models")]
 static WHOLE_ALPHA_NM: [i64; 321] = [
     10000000000, 10000000000, -4676190269, 1058820179, 10000000000, -10000000000, -10000000000, 10000000000,
     -1190502042, -10000000000, 10000000000, 10000000000, 10000000000, 10000000000, -3703647047, -902995421,
@@ -2509,18 +2514,22 @@ static WHOLE_ALPHA_NM: [i64; 321] = [
     10000000000, 10000000000, 2154853937, 10000000000, 10000000000, -10000000000, -6816720964, -9813038082,
     -10000000000,
 ];
+#[cfg(feature = "all-models")]
 static BOOST_PUSH_OFF_0_FEATURES: [u8; 9] = [
     21 /* push_off.mag.weinberg */, 0 /* push_off.vert.max */, 5 /* push_off.vert.weinberg */, 6 /* push_off.vert.kim */, 13 /* push_off.sag.weinberg */, 16 /* push_off.mag.max */, 22 /* push_off.mag.kim */, 18 /* push_off.mag.range */,
     105 /* stride..zupt_length */,
 ];
+#[cfg(feature = "all-models")]
 static BOOST_PUSH_OFF_0_MEAN_Q16: [i64; 9] = [
     73029, 86089, 70755, 48410, 75773, 112840, 52491, 113898,
     81919,
 ];
+#[cfg(feature = "all-models")]
 static BOOST_PUSH_OFF_0_INV_STD_Q32: [i64; 9] = [
     25245158026, 5992328424, 23797500732, 34822800824, 23343507298, 4598348682, 31848779789, 4739880959,
     6083102838,
 ];
+#[cfg(feature = "all-models")]
 static BOOST_PUSH_OFF_0_SUPPORT_Q16: [i32; 5616] = [
     30092, 53027, 31932, 43740, 31504, 23906, 32611, 20542,
     -1889, -38748, -52785, -40693, -33884, 30, -46945, -30649,
@@ -3225,6 +3234,7 @@ static BOOST_PUSH_OFF_0_SUPPORT_Q16: [i32; 5616] = [
     36562, 38660, 11858, 27709, 24507, 23862, 195, 9153,
     -13094, 30082, -623, 31954, -2954, -10131, -4355, 16613,
 ];
+#[cfg(feature = "all-models")]
 static BOOST_PUSH_OFF_0_ALPHA_NM: [i64; 624] = [
     1000000000, -1000000000, -1000000000, -1000000000, -896290677, 1000000000, -1000000000, 1000000000,
     -1000000000, 1000000000, 1000000000, -1000000000, -1000000000, 1000000000, -1000000000, -1000000000,
@@ -3305,18 +3315,22 @@ static BOOST_PUSH_OFF_0_ALPHA_NM: [i64; 624] = [
     -1000000000, 1000000000, -1000000000, 1000000000, -1000000000, 1000000000, -1000000000, -1000000000,
     1000000000, 1000000000, 1000000000, -1000000000, -1000000000, 1000000000, 1000000000, 1000000000,
 ];
+#[cfg(feature = "all-models")]
 static BOOST_PUSH_OFF_1_FEATURES: [u8; 9] = [
     21 /* push_off.mag.weinberg */, 0 /* push_off.vert.max */, 5 /* push_off.vert.weinberg */, 6 /* push_off.vert.kim */, 13 /* push_off.sag.weinberg */, 16 /* push_off.mag.max */, 22 /* push_off.mag.kim */, 18 /* push_off.mag.range */,
     105 /* stride..zupt_length */,
 ];
+#[cfg(feature = "all-models")]
 static BOOST_PUSH_OFF_1_MEAN_Q16: [i64; 9] = [
     73483, 90467, 71686, 48895, 76147, 116811, 52907, 117517,
     84838,
 ];
+#[cfg(feature = "all-models")]
 static BOOST_PUSH_OFF_1_INV_STD_Q32: [i64; 9] = [
     24899663515, 5292131770, 23387799519, 33749886208, 23287504676, 4206333019, 30246563830, 4291111789,
     5223346985,
 ];
+#[cfg(feature = "all-models")]
 static BOOST_PUSH_OFF_1_SUPPORT_Q16: [i32; 6255] = [
     51155, 67184, 42381, 49233, -4316, 48534, 33631, 45482,
     17919, -61449, -53470, -48431, -69045, -70113, -67234, -76357,
@@ -4101,6 +4115,7 @@ static BOOST_PUSH_OFF_1_SUPPORT_Q16: [i32; 6255] = [
     -21440, 98977, 107954, -10319, 118089, 45110, 70939, 102907,
     58773, 114214, 6729, 82914, 98918, 74224, 11850,
 ];
+#[cfg(feature = "all-models")]
 static BOOST_PUSH_OFF_1_ALPHA_NM: [i64; 695] = [
     -1000000000, 1000000000, -1000000000, 1000000000, -1000000000, -1000000000, 1000000000, 1000000000,
     -1000000000, 1000000000, -1000000000, 873835797, 1000000000, -1000000000, 1000000000, -1000000000,
@@ -4190,18 +4205,22 @@ static BOOST_PUSH_OFF_1_ALPHA_NM: [i64; 695] = [
     1000000000, 1000000000, -1000000000, -1000000000, 263949038, 1000000000, -1000000000, 1000000000,
     -1000000000, 1000000000, 1000000000, 1000000000, 1000000000, -1000000000, 1000000000,
 ];
+#[cfg(feature = "all-models")]
 static BOOST_PUSH_OFF_2_FEATURES: [u8; 9] = [
     21 /* push_off.mag.weinberg */, 0 /* push_off.vert.max */, 5 /* push_off.vert.weinberg */, 6 /* push_off.vert.kim */, 13 /* push_off.sag.weinberg */, 16 /* push_off.mag.max */, 22 /* push_off.mag.kim */, 18 /* push_off.mag.range */,
     105 /* stride..zupt_length */,
 ];
+#[cfg(feature = "all-models")]
 static BOOST_PUSH_OFF_2_MEAN_Q16: [i64; 9] = [
     74021, 89626, 71649, 48757, 76616, 121354, 53423, 122077,
     90377,
 ];
+#[cfg(feature = "all-models")]
 static BOOST_PUSH_OFF_2_INV_STD_Q32: [i64; 9] = [
     23925265342, 5321984936, 23944284158, 33161122479, 20717757320, 3955945899, 28770947258, 4041361978,
     4399550655,
 ];
+#[cfg(feature = "all-models")]
 static BOOST_PUSH_OFF_2_SUPPORT_Q16: [i32; 6282] = [
     85442, 99890, 92314, 55346, 70987, 97579, 56198, 98284,
     29121, 955, 7184, 1263, 12174, -7403, -11770, -10326,
@@ -4990,6 +5009,7 @@ static BOOST_PUSH_OFF_2_SUPPORT_Q16: [i32; 6282] = [
     25514, -29298, -13633, -18511, 7564, -46862, -37442, -7096,
     -40134, -1553,
 ];
+#[cfg(feature = "all-models")]
 static BOOST_PUSH_OFF_2_ALPHA_NM: [i64; 698] = [
     1000000000, 1000000000, -624536302, -1000000000, 994383241, 1000000000, 1000000000, 1000000000,
     1000000000, -509360027, 1000000000, -1000000000, -1000000000, -1000000000, 1000000000, 1000000000,
@@ -5080,18 +5100,22 @@ static BOOST_PUSH_OFF_2_ALPHA_NM: [i64; 698] = [
     -1000000000, -1000000000, 987307241, -1000000000, 1000000000, 1000000000, -1000000000, 1000000000,
     1000000000, -1000000000,
 ];
+#[cfg(feature = "all-models")]
 static BOOST_PUSH_OFF_3_FEATURES: [u8; 9] = [
     21 /* push_off.mag.weinberg */, 0 /* push_off.vert.max */, 5 /* push_off.vert.weinberg */, 6 /* push_off.vert.kim */, 13 /* push_off.sag.weinberg */, 16 /* push_off.mag.max */, 22 /* push_off.mag.kim */, 18 /* push_off.mag.range */,
     105 /* stride..zupt_length */,
 ];
+#[cfg(feature = "all-models")]
 static BOOST_PUSH_OFF_3_MEAN_Q16: [i64; 9] = [
     74348, 94248, 72505, 49525, 77003, 124613, 54013, 124429,
     88153,
 ];
+#[cfg(feature = "all-models")]
 static BOOST_PUSH_OFF_3_INV_STD_Q32: [i64; 9] = [
     23547138480, 5232151520, 23483255497, 32105486134, 20799504945, 3940400242, 27668548057, 4041527977,
     5654937903,
 ];
+#[cfg(feature = "all-models")]
 static BOOST_PUSH_OFF_3_SUPPORT_Q16: [i32; 6615] = [
     -23971, -30650, -24859, 6473, -6229, -32269, -10706, -36929,
     -6763, 10817, 19131, 11618, 30705, -35599, -415, 11713,
@@ -5921,6 +5945,7 @@ static BOOST_PUSH_OFF_3_SUPPORT_Q16: [i32; 6615] = [
     20274, 4403, 3460, 10540, 2818, -2867, 28567, 40883,
     26032, 55458, -10550, 17552, 36558, 16850, -28056,
 ];
+#[cfg(feature = "all-models")]
 static BOOST_PUSH_OFF_3_ALPHA_NM: [i64; 735] = [
     -1000000000, 1000000000, -1000000000, -1000000000, -1000000000, 1000000000, -1000000000, 75788316,
     1000000000, -1000000000, 1000000000, 1000000000, 1000000000, 1000000000, 1000000000, -1000000000,
@@ -6015,6 +6040,7 @@ static BOOST_PUSH_OFF_3_ALPHA_NM: [i64; 735] = [
     1000000000, 1000000000, -1000000000, -1000000000, -1000000000, -1000000000, -1000000000, -1000000000,
     -1000000000, 1000000000, -1000000000, 1000000000, 1000000000, -1000000000, 1000000000,
 ];
+#[cfg(feature = "all-models")]
 static BOOST_PUSH_OFF: [Svr<'static>; 4] = [
     Svr {
         features: &BOOST_PUSH_OFF_0_FEATURES,
@@ -6053,21 +6079,26 @@ static BOOST_PUSH_OFF: [Svr<'static>; 4] = [
         rho_nm: -1097752074,
     },
 ];
+#[cfg(feature = "all-models")]
 static BOOST_PUSH_OFF_WEIGHTS_Q16: [u32; 4] = [
     162372, 135098, 113964, 138295,
 ];
+#[cfg(feature = "all-models")]
 static BOOST_SWING_0_FEATURES: [u8; 9] = [
     39 /* swing.sag.weinberg */, 48 /* swing.mag.kim */, 36 /* swing.sag.range */, 40 /* swing.sag.kim */, 45 /* swing.mag.mean_abs */, 32 /* swing.vert.kim */, 37 /* swing.sag.mean_abs */, 35 /* swing.sag.min */,
     105 /* stride..zupt_length */,
 ];
+#[cfg(feature = "all-models")]
 static BOOST_SWING_0_MEAN_Q16: [i64; 9] = [
     87584, 58652, 238743, 59980, 53241, 49529, 54971, -144739,
     79905,
 ];
+#[cfg(feature = "all-models")]
 static BOOST_SWING_0_INV_STD_Q32: [i64; 9] = [
     19804837854, 22520936831, 2330346565, 25939010930, 9370893190, 36402830977, 10977625794, 3489485680,
     6032091033,
 ];
+#[cfg(feature = "all-models")]
 static BOOST_SWING_0_SUPPORT_Q16: [i32; 2484] = [
     -3586, 775, -20083, 1772, -12892, -19069, -10196, 4240,
     38894, 61964, 67522, 71226, 32027, 69747, 56092, 25071,
@@ -6381,6 +6412,7 @@ static BOOST_SWING_0_SUPPORT_Q16: [i32; 2484] = [
     42393, -56077, 11153, 71989, 83237, 89074, 99181, 94107,
     91512, 124902, 34035, -3002,
 ];
+#[cfg(feature = "all-models")]
 static BOOST_SWING_0_ALPHA_NM: [i64; 276] = [
     -1000000000, -1000000000, -1000000000, -1000000000, 1000000000, 1000000000, -1000000000, -1000000000,
     137371805, 1000000000, 1000000000, -1000000000, 1000000000, -157365963, 1000000000, 927786478,
@@ -6418,18 +6450,22 @@ static BOOST_SWING_0_ALPHA_NM: [i64; 276] = [
     -858563035, -1000000000, -1000000000, -1000000000, -1000000000, 1000000000, 1000000000, 376331527,
     117794077, 352410826, 1000000000, -1000000000,
 ];
+#[cfg(feature = "all-models")]
 static BOOST_SWING_1_FEATURES: [u8; 9] = [
     39 /* swing.sag.weinberg */, 48 /* swing.mag.kim */, 36 /* swing.sag.range */, 40 /* swing.sag.kim */, 45 /* swing.mag.mean_abs */, 32 /* swing.vert.kim */, 37 /* swing.sag.mean_abs */, 35 /* swing.sag.min */,
     105 /* stride..zupt_length */,
 ];
+#[cfg(feature = "all-models")]
 static BOOST_SWING_1_MEAN_Q16: [i64; 9] = [
     89369, 60066, 256205, 61336, 56599, 50267, 58210, -156451,
     83028,
 ];
+#[cfg(feature = "all-models")]
 static BOOST_SWING_1_INV_STD_Q32: [i64; 9] = [
     20513388747, 23085550535, 2197073632, 27085134471, 9085472073, 37681273551, 10721597086, 3282970859,
     6743073802,
 ];
+#[cfg(feature = "all-models")]
 static BOOST_SWING_1_SUPPORT_Q16: [i32; 3240] = [
     27635, 10520, 17934, 15712, -2215, 8395, 5824, 21650,
     -13521, -1439, -9005, -16687, -11440, -21677, 3772, -22744,
@@ -6837,6 +6873,7 @@ static BOOST_SWING_1_SUPPORT_Q16: [i32; 3240] = [
     16526, 7759, -6444, -1448, -2959, -11323, 1123, -116697,
     -121919, -98747, -47055, -93997, -140796, -54426, 60150, -120101,
 ];
+#[cfg(feature = "all-models")]
 static BOOST_SWING_1_ALPHA_NM: [i64; 360] = [
     -1000000000, 1000000000, -1000000000, 1000000000, 1000000000, 1000000000, -1000000000, 1000000000,
     -1000000000, 920043715, 1000000000, -1000000000, 1000000000, -1000000000, -1000000000, 1000000000,
@@ -6884,18 +6921,22 @@ static BOOST_SWING_1_ALPHA_NM: [i64; 360] = [
     1000000000, 1000000000, 1000000000, 1000000000, -1000000000, 1000000000, 1000000000, 998359119,
     -1000000000, 1000000000, 1000000000, -1000000000, -191578264, -737617377, 1000000000, -442024596,
 ];
+#[cfg(feature = "all-models")]
 static BOOST_SWING_2_FEATURES: [u8; 9] = [
     39 /* swing.sag.weinberg */, 48 /* swing.mag.kim */, 36 /* swing.sag.range */, 40 /* swing.sag.kim */, 45 /* swing.mag.mean_abs */, 32 /* swing.vert.kim */, 37 /* swing.sag.mean_abs */, 35 /* swing.sag.min */,
     105 /* stride..zupt_length */,
 ];
+#[cfg(feature = "all-models")]
 static BOOST_SWING_2_MEAN_Q16: [i64; 9] = [
     90058, 59909, 264358, 60980, 56632, 49951, 57283, -160623,
     88943,
 ];
+#[cfg(feature = "all-models")]
 static BOOST_SWING_2_INV_STD_Q32: [i64; 9] = [
     20302308649, 22187401050, 2130728401, 27032080640, 8965022396, 36369310478, 10757647004, 3204364179,
     4856687500,
 ];
+#[cfg(feature = "all-models")]
 static BOOST_SWING_2_SUPPORT_Q16: [i32; 4590] = [
     51824, 60027, 52417, 27085, 59648, 52465, 18776, -60654,
     27049, 68707, 74826, 79786, 116000, 81885, 22411, 148550,
@@ -7472,6 +7513,7 @@ static BOOST_SWING_2_SUPPORT_Q16: [i32; 4590] = [
     59648, 52465, 18776, -60654, 27049, 60798, 74460, 66609,
     45011, 81314, 74159, 40953, 11041, 115239,
 ];
+#[cfg(feature = "all-models")]
 static BOOST_SWING_2_ALPHA_NM: [i64; 510] = [
     -1000000000, -1000000000, 1000000000, 1000000000, -1000000000, 1000000000, -1000000000, 1000000000,
     1000000000, 1000000000, 1000000000, -305384442, 1000000000, -1000000000, -1000000000, 1000000000,
@@ -7538,18 +7580,22 @@ static BOOST_SWING_2_ALPHA_NM: [i64; 510] = [
     -1000000000, 658591408, 1000000000, 1000000000, -1000000000, -1000000000, -407401990, 1000000000,
     1000000000, 1000000000, -1000000000, 1000000000, -1000000000, -1000000000,
 ];
+#[cfg(feature = "all-models")]
 static BOOST_SWING_3_FEATURES: [u8; 9] = [
     39 /* swing.sag.weinberg */, 48 /* swing.mag.kim */, 36 /* swing.sag.range */, 40 /* swing.sag.kim */, 45 /* swing.mag.mean_abs */, 32 /* swing.vert.kim */, 37 /* swing.sag.mean_abs */, 35 /* swing.sag.min */,
     105 /* stride..zupt_length */,
 ];
+#[cfg(feature = "all-models")]
 static BOOST_SWING_3_MEAN_Q16: [i64; 9] = [
     88041, 58848, 250348, 59165, 54521, 49673, 53786, -153059,
     87590,
 ];
+#[cfg(feature = "all-models")]
 static BOOST_SWING_3_INV_STD_Q32: [i64; 9] = [
     17991456985, 21259786682, 2070464399, 23817790512, 8769590197, 35438938435, 10210640797, 3068303247,
     5079040733,
 ];
+#[cfg(feature = "all-models")]
 static BOOST_SWING_3_SUPPORT_Q16: [i32; 5481] = [
     45577, 63530, 43311, 53297, 63785, 48564, 52199, -75232,
     22130, 50742, 69157, 51641, 70762, 72249, 54744, 78086,
@@ -8238,6 +8284,7 @@ static BOOST_SWING_3_SUPPORT_Q16: [i32; 5481] = [
     57120, 41893, 62362, -12417, 33664, 55607, -25761, -74798,
     109419,
 ];
+#[cfg(feature = "all-models")]
 static BOOST_SWING_3_ALPHA_NM: [i64; 609] = [
     1000000000, -1000000000, -1000000000, -1000000000, -1000000000, 1000000000, -1000000000, 1000000000,
     -1000000000, 1000000000, 1000000000, -1000000000, 515302860, -1000000000, 407528179, 1000000000,
@@ -8317,6 +8364,7 @@ static BOOST_SWING_3_ALPHA_NM: [i64; 609] = [
     567866554, -1000000000, -1000000000, 1000000000, 1000000000, -1000000000, 1000000000, -1000000000,
     1000000000,
 ];
+#[cfg(feature = "all-models")]
 static BOOST_SWING: [Svr<'static>; 4] = [
     Svr {
         features: &BOOST_SWING_0_FEATURES,
@@ -8355,21 +8403,26 @@ static BOOST_SWING: [Svr<'static>; 4] = [
         rho_nm: -963397616,
     },
 ];
+#[cfg(feature = "all-models")]
 static BOOST_SWING_WEIGHTS_Q16: [u32; 4] = [
     164254, 135731, 99787, 117338,
 ];
+#[cfg(feature = "all-models")]
 static BOOST_HEEL_STRIKE_0_FEATURES: [u8; 9] = [
     65 /* heel_strike.sag.weinberg */, 74 /* heel_strike.mag.kim */, 73 /* heel_strike.mag.weinberg */, 58 /* heel_strike.vert.kim */, 57 /* heel_strike.vert.weinberg */, 66 /* heel_strike.sag.kim */, 71 /* heel_strike.mag.mean_abs */, 62 /* heel_strike.sag.range */,
     105 /* stride..zupt_length */,
 ];
+#[cfg(feature = "all-models")]
 static BOOST_HEEL_STRIKE_0_MEAN_Q16: [i64; 9] = [
     75523, 50984, 72112, 44574, 67569, 47191, 33871, 136086,
     79367,
 ];
+#[cfg(feature = "all-models")]
 static BOOST_HEEL_STRIKE_0_INV_STD_Q32: [i64; 9] = [
     21512877443, 30759624232, 21449582780, 40371576061, 22409292941, 36004312067, 15357613689, 3213464495,
     7633850455,
 ];
+#[cfg(feature = "all-models")]
 static BOOST_HEEL_STRIKE_0_SUPPORT_Q16: [i32; 5292] = [
     16812, 4077, 39821, -1076, 22312, -11713, -7045, 1085,
     44529, -65604, -89756, -48330, -95991, -54381, -81643, -73785,
@@ -9034,6 +9087,7 @@ static BOOST_HEEL_STRIKE_0_SUPPORT_Q16: [i32; 5292] = [
     120822, 210363, 12366, -29675, -60415, -18474, -72439, -17889,
     -13081, -56987, -39449, 25499,
 ];
+#[cfg(feature = "all-models")]
 static BOOST_HEEL_STRIKE_0_ALPHA_NM: [i64; 588] = [
     1000000000, -1000000000, 1000000000, -1000000000, 811527120, 1000000000, -1000000000, 421723155,
     1000000000, 1000000000, 1000000000, -1000000000, -1000000000, 1000000000, -1000000000, 1000000000,
@@ -9110,18 +9164,22 @@ static BOOST_HEEL_STRIKE_0_ALPHA_NM: [i64; 588] = [
     -648136953, 139841568, 1000000000, -1000000000, -1000000000, -1000000000, 1000000000, 1000000000,
     1000000000, -1000000000, -31281124, 905053142,
 ];
+#[cfg(feature = "all-models")]
 static BOOST_HEEL_STRIKE_1_FEATURES: [u8; 9] = [
     65 /* heel_strike.sag.weinberg */, 74 /* heel_strike.mag.kim */, 73 /* heel_strike.mag.weinberg */, 58 /* heel_strike.vert.kim */, 57 /* heel_strike.vert.weinberg */, 66 /* heel_strike.sag.kim */, 71 /* heel_strike.mag.mean_abs */, 62 /* heel_strike.sag.range */,
     105 /* stride..zupt_length */,
 ];
+#[cfg(feature = "all-models")]
 static BOOST_HEEL_STRIKE_1_MEAN_Q16: [i64; 9] = [
     76559, 51993, 73210, 44727, 67985, 48239, 36214, 148529,
     85486,
 ];
+#[cfg(feature = "all-models")]
 static BOOST_HEEL_STRIKE_1_INV_STD_Q32: [i64; 9] = [
     18949753901, 28941897032, 20828345256, 39082294484, 21311043516, 31458095152, 13670424317, 2771622422,
     6027310192,
 ];
+#[cfg(feature = "all-models")]
 static BOOST_HEEL_STRIKE_1_SUPPORT_Q16: [i32; 6012] = [
     27878, -2543, -14165, 1050, 5188, 27453, -13359, 12317,
     15814, -34403, -39560, -37722, -21928, -29392, -43757, -42556,
@@ -9876,6 +9934,7 @@ static BOOST_HEEL_STRIKE_1_SUPPORT_Q16: [i32; 6012] = [
     -23262, -20104, 64362, -44355, -100336, -67399, -104094, -49279,
     -5001, -77413, -50996, -85135,
 ];
+#[cfg(feature = "all-models")]
 static BOOST_HEEL_STRIKE_1_ALPHA_NM: [i64; 668] = [
     1000000000, -1000000000, -1000000000, -1000000000, 220160343, -1000000000, -1000000000, -1000000000,
     1000000000, 1000000000, 1000000000, -1000000000, -1000000000, 1000000000, -1000000000, -1000000000,
@@ -9962,18 +10021,22 @@ static BOOST_HEEL_STRIKE_1_ALPHA_NM: [i64; 668] = [
     -1000000000, -401124998, 609570379, 1000000000, -1000000000, 1000000000, -1000000000, 1000000000,
     -1000000000, 1000000000, -1000000000, -1000000000,
 ];
+#[cfg(feature = "all-models")]
 static BOOST_HEEL_STRIKE_2_FEATURES: [u8; 9] = [
     65 /* heel_strike.sag.weinberg */, 74 /* heel_strike.mag.kim */, 73 /* heel_strike.mag.weinberg */, 58 /* heel_strike.vert.kim */, 57 /* heel_strike.vert.weinberg */, 66 /* heel_strike.sag.kim */, 71 /* heel_strike.mag.mean_abs */, 62 /* heel_strike.sag.range */,
     105 /* stride..zupt_length */,
 ];
+#[cfg(feature = "all-models")]
 static BOOST_HEEL_STRIKE_2_MEAN_Q16: [i64; 9] = [
     75818, 51680, 73313, 44857, 68635, 48247, 35925, 141625,
     82928,
 ];
+#[cfg(feature = "all-models")]
 static BOOST_HEEL_STRIKE_2_INV_STD_Q32: [i64; 9] = [
     19558232668, 27635379943, 20490426936, 37570868297, 21365974805, 30851910612, 13278243359, 3017243560,
     6434608170,
 ];
+#[cfg(feature = "all-models")]
 static BOOST_HEEL_STRIKE_2_SUPPORT_Q16: [i32; 6759] = [
     53596, 57412, 108591, 83754, 138688, 59854, 49152, 47393,
     13445, -23768, -21453, -16234, 183, -20257, -71847, -29723,
@@ -10821,6 +10884,7 @@ static BOOST_HEEL_STRIKE_2_SUPPORT_Q16: [i32; 6759] = [
     -31055, -44619, -21963, -42857, -22070, -24324, -79596, -52141,
     -105332, -27670, -88838, -74664, -51499, -70583, -64602,
 ];
+#[cfg(feature = "all-models")]
 static BOOST_HEEL_STRIKE_2_ALPHA_NM: [i64; 751] = [
     -327668341, -542942890, 1000000000, -1000000000, -1000000000, 1000000000, 1000000000, 1000000000,
     -1000000000, -360178446, -214264044, -1000000000, 1000000000, 1000000000, -1000000000, 1000000000,
@@ -10917,18 +10981,22 @@ static BOOST_HEEL_STRIKE_2_ALPHA_NM: [i64; 751] = [
     1000000000, -418272331, 1000000000, -1000000000, -1000000000, 1000000000, 1000000000, 694928490,
     1000000000, -1000000000, -1000000000, 1000000000, -1000000000, 1000000000, -1000000000,
 ];
+#[cfg(feature = "all-models")]
 static BOOST_HEEL_STRIKE_3_FEATURES: [u8; 9] = [
     65 /* heel_strike.sag.weinberg */, 74 /* heel_strike.mag.kim */, 73 /* heel_strike.mag.weinberg */, 58 /* heel_strike.vert.kim */, 57 /* heel_strike.vert.weinberg */, 66 /* heel_strike.sag.kim */, 71 /* heel_strike.mag.mean_abs */, 62 /* heel_strike.sag.range */,
     105 /* stride..zupt_length */,
 ];
+#[cfg(feature = "all-models")]
 static BOOST_HEEL_STRIKE_3_MEAN_Q16: [i64; 9] = [
     77226, 52468, 74598, 45242, 69919, 49173, 38065, 151994,
     93334,
 ];
+#[cfg(feature = "all-models")]
 static BOOST_HEEL_STRIKE_3_INV_STD_Q32: [i64; 9] = [
     19341702353, 25586949573, 19686287530, 34490650387, 20711271577, 29291133126, 12225909898, 2863736652,
     5332997039,
 ];
+#[cfg(feature = "all-models")]
 static BOOST_HEEL_STRIKE_3_SUPPORT_Q16: [i32; 6795] = [
     -21797, -14817, -11843, -13427, -22610, -30178, -25601, -36311,
     -3325, -1011, -338, 20085, 19900, 41092, -13404, -12933,
@@ -11781,6 +11849,7 @@ static BOOST_HEEL_STRIKE_3_SUPPORT_Q16: [i32; 6795] = [
     -53785, -44101, 17983, 21908, 8731, 17590, -9868, -4619,
     8950, 1732, 2418,
 ];
+#[cfg(feature = "all-models")]
 static BOOST_HEEL_STRIKE_3_ALPHA_NM: [i64; 755] = [
     1000000000, 1000000000, -1000000000, 1000000000, 1000000000, -1000000000, -1000000000, 1000000000,
     -1000000000, -1000000000, 1000000000, -1000000000, 1000000000, 1000000000, -1000000000, 1000000000,
@@ -11878,6 +11947,7 @@ static BOOST_HEEL_STRIKE_3_ALPHA_NM: [i64; 755] = [
     -1000000000, 171335408, 1000000000, -1000000000, 1000000000, -1000000000, -1000000000, -995996716,
     1000000000, -1000000000, 1000000000,
 ];
+#[cfg(feature = "all-models")]
 static BOOST_HEEL_STRIKE: [Svr<'static>; 4] = [
     Svr {
         features: &BOOST_HEEL_STRIKE_0_FEATURES,
@@ -11916,11 +11986,13 @@ static BOOST_HEEL_STRIKE: [Svr<'static>; 4] = [
         rho_nm: -964982710,
     },
 ];
+#[cfg(feature = "all-models")]
 static BOOST_HEEL_STRIKE_WEIGHTS_Q16: [u32; 4] = [
     186800, 137074, 119135, 99714,
 ];
 
-/// The trained models the firmware ships.
+/// The trained models. Builds without the `all-models` feature carry the default
+/// model's SVRs only ([`ModelParams::ships`]).
 pub static PARAMS: ModelParams<'static> = ModelParams {
     linear: [
         // weinberg: [0.9301354432663147] m per basis unit
@@ -11974,6 +12046,7 @@ pub static PARAMS: ModelParams<'static> = ModelParams {
         rho_nm: -1016660990,
     },
     ],
+    #[cfg(feature = "all-models")]
     whole: Svr {
         features: &WHOLE_FEATURES,
         mean_q16: &WHOLE_MEAN_Q16,
@@ -11983,6 +12056,9 @@ pub static PARAMS: ModelParams<'static> = ModelParams {
         alpha_nm: &WHOLE_ALPHA_NM,
         rho_nm: -901270769,
     },
+    #[cfg(not(feature = "all-models"))]
+    whole: Svr::ABSENT,
+    #[cfg(feature = "all-models")]
     adaboost: [
         Boosted {
             members: &BOOST_PUSH_OFF,
@@ -11997,4 +12073,6 @@ pub static PARAMS: ModelParams<'static> = ModelParams {
             weights_q16: &BOOST_HEEL_STRIKE_WEIGHTS_Q16,
         },
     ],
+    #[cfg(not(feature = "all-models"))]
+    adaboost: [Boosted::ABSENT; 3],
 };

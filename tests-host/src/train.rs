@@ -23,7 +23,7 @@ use anyhow::{bail, Context, Result};
 use gaitclip::features::{self, Features, COUNT, PER_SEGMENT, ZUPT_LENGTH};
 use gaitclip::models::{Model, ModelParams, Settings, LINEAR_MODELS, MAX_TERMS};
 use gaitclip::phase_stats::{Channel, Segment};
-use gaitclip::pipeline::Config;
+use gaitclip::pipeline::{Config, DEFAULT_MODEL};
 use gaitclip::rate::SampleRate;
 use gaitclip::stride::Stride;
 use gaitclip::svr::{Boosted, Svr};
@@ -739,8 +739,29 @@ pub fn train(runs: &[TrialRun]) -> Result<Training> {
     })
 }
 
-fn array<T: std::fmt::Display>(out: &mut String, name: &str, ty: &str, v: &[T]) {
-    let _ = write!(out, "static {name}: [{ty}; {}] = [", v.len());
+/// `#[cfg]` line of the tables of a model that only builds with the `all-models` feature
+/// (every SVR model but the pipeline's default), or nothing.
+fn gate(model: Model) -> &'static str {
+    if model == DEFAULT_MODEL {
+        ""
+    } else {
+        "#[cfg(feature = \"all-models\")]\n"
+    }
+}
+
+/// A `PARAMS` field: the trained value, or `absent` in builds without the model.
+fn field(model: Model, name: &str, value: &str, absent: &str) -> String {
+    if model == DEFAULT_MODEL {
+        format!("    {name}: {value},\n")
+    } else {
+        format!(
+            "    #[cfg(feature = \"all-models\")]\n    {name}: {value},\n    #[cfg(not(feature = \"all-models\"))]\n    {name}: {absent},\n"
+        )
+    }
+}
+
+fn array<T: std::fmt::Display>(out: &mut String, gate: &str, name: &str, ty: &str, v: &[T]) {
+    let _ = write!(out, "{gate}static {name}: [{ty}; {}] = [", v.len());
     for (i, x) in v.iter().enumerate() {
         if i % 8 == 0 {
             out.push_str("\n    ");
@@ -752,7 +773,7 @@ fn array<T: std::fmt::Display>(out: &mut String, name: &str, ty: &str, v: &[T]) 
     out.push_str("\n];\n");
 }
 
-fn svr_source(out: &mut String, name: &str, s: &SvrQ) -> String {
+fn svr_source(out: &mut String, gate: &str, name: &str, s: &SvrQ) -> String {
     let features: Vec<String> = s
         .features
         .iter()
@@ -761,11 +782,11 @@ fn svr_source(out: &mut String, name: &str, s: &SvrQ) -> String {
             format!("{i} /* {a}.{b}.{c} */")
         })
         .collect();
-    array(out, &format!("{name}_FEATURES"), "u8", &features);
-    array(out, &format!("{name}_MEAN_Q16"), "i64", &s.mean_q16);
-    array(out, &format!("{name}_INV_STD_Q32"), "i64", &s.inv_std_q32);
-    array(out, &format!("{name}_SUPPORT_Q16"), "i32", &s.support_q16);
-    array(out, &format!("{name}_ALPHA_NM"), "i64", &s.alpha_nm);
+    array(out, gate, &format!("{name}_FEATURES"), "u8", &features);
+    array(out, gate, &format!("{name}_MEAN_Q16"), "i64", &s.mean_q16);
+    array(out, gate, &format!("{name}_INV_STD_Q32"), "i64", &s.inv_std_q32);
+    array(out, gate, &format!("{name}_SUPPORT_Q16"), "i32", &s.support_q16);
+    array(out, gate, &format!("{name}_ALPHA_NM"), "i64", &s.alpha_nm);
     format!(
         "Svr {{\n        features: &{name}_FEATURES,\n        mean_q16: &{name}_MEAN_Q16,\n        inv_std_q32: &{name}_INV_STD_Q32,\n        gamma_q32: {},\n        support_q16: &{name}_SUPPORT_Q16,\n        alpha_nm: &{name}_ALPHA_NM,\n        rho_nm: {},\n    }}",
         s.gamma_q32, s.rho_nm
@@ -780,25 +801,35 @@ pub fn rust_source(t: &Training) -> String {
         .fusion
         .iter()
         .zip(["PUSH_OFF", "SWING", "HEEL_STRIKE"])
-        .map(|(s, n)| svr_source(&mut body, &format!("FUSION_{n}"), &s.quantize()))
+        .map(|(s, n)| {
+            let g = gate(Model::HuangSvrFusion);
+            svr_source(&mut body, g, &format!("FUSION_{n}"), &s.quantize())
+        })
         .collect();
-    let whole = svr_source(&mut body, "WHOLE", &tr.whole.quantize());
+    let whole = svr_source(
+        &mut body,
+        gate(Model::HuangSvrWhole),
+        "WHOLE",
+        &tr.whole.quantize(),
+    );
+    let boost_gate = gate(Model::HuangSvrAdaBoost);
     let mut boosted = Vec::new();
     for (b, n) in tr.adaboost.iter().zip(["PUSH_OFF", "SWING", "HEEL_STRIKE"]) {
         let members: Vec<String> = b
             .members
             .iter()
             .enumerate()
-            .map(|(k, m)| svr_source(&mut body, &format!("BOOST_{n}_{k}"), &m.quantize()))
+            .map(|(k, m)| svr_source(&mut body, boost_gate, &format!("BOOST_{n}_{k}"), &m.quantize()))
             .collect();
         let _ = writeln!(
             body,
-            "static BOOST_{n}: [Svr<'static>; {}] = [\n    {},\n];",
+            "{boost_gate}static BOOST_{n}: [Svr<'static>; {}] = [\n    {},\n];",
             members.len(),
             members.join(",\n    ")
         );
         array(
             &mut body,
+            boost_gate,
             &format!("BOOST_{n}_WEIGHTS_Q16"),
             "u32",
             &b.weights_q16(),
@@ -838,7 +869,7 @@ pub fn rust_source(t: &Training) -> String {
     }
     s.push_str("];\n\n");
     s.push_str(&body);
-    s.push_str("\n/// The trained models the firmware ships.\npub static PARAMS: ModelParams<'static> = ModelParams {\n    linear: [\n");
+    s.push_str("\n/// The trained models. Builds without the `all-models` feature carry the default\n/// model's SVRs only ([`ModelParams::ships`]).\npub static PARAMS: ModelParams<'static> = ModelParams {\n    linear: [\n");
     let lq = tr.linear_q();
     for m in Model::ALL {
         if let Some(k) = m.linear_index() {
@@ -852,14 +883,20 @@ pub fn rust_source(t: &Training) -> String {
         }
     }
     let lu = tr.lu_q();
-    let _ = write!(
-        s,
-        "    ],\n    lu_d_range_q16: ({}, {}),\n    fusion: [\n        {},\n    ],\n    whole: {},\n    adaboost: [\n        {},\n    ],\n}};\n",
-        lu.0,
-        lu.1,
-        fusion.join(",\n        "),
-        whole,
-        boosted.join(",\n        ")
-    );
+    let _ = writeln!(s, "    ],\n    lu_d_range_q16: ({}, {}),", lu.0, lu.1);
+    s.push_str(&field(
+        Model::HuangSvrFusion,
+        "fusion",
+        &format!("[\n        {},\n    ]", fusion.join(",\n        ")),
+        "[Svr::ABSENT; 3]",
+    ));
+    s.push_str(&field(Model::HuangSvrWhole, "whole", &whole, "Svr::ABSENT"));
+    s.push_str(&field(
+        Model::HuangSvrAdaBoost,
+        "adaboost",
+        &format!("[\n        {},\n    ]", boosted.join(",\n        ")),
+        "[Boosted::ABSENT; 3]",
+    ));
+    s.push_str("};\n");
     s
 }
