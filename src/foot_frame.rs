@@ -151,6 +151,12 @@ impl FootFrameEstimator {
         self.frame
     }
 
+    /// Gyroscope bias, counts: the mean angular rate of the last rest period (zero before
+    /// the first). The movement axis is learnt from the rates minus this bias.
+    pub const fn gyro_bias(&self) -> [i32; 3] {
+        self.gyro_bias
+    }
+
     /// Feeds one raw sample and the rest decision about it.
     pub fn process(&mut self, s: &RawSample, rest: bool) {
         match (self.was_rest, rest) {

@@ -267,6 +267,20 @@ impl<I: I2c> Mpu6050<I> {
         self.write_reg(reg::INT_ENABLE, bits::DATA_RDY | bits::FIFO_OFLOW)
     }
 
+    /// Pulses INT (50 µs, active high) on every data ready, without latching: for reading
+    /// the FIFO in bursts, where most pulses are only counted and no register is read to
+    /// clear a latch. FIFO overflow is found by [`Mpu6050::read_fifo`] from `INT_STATUS`.
+    pub fn enable_data_ready_pulse(&mut self) -> Result<(), Error<I::Error>> {
+        self.write_reg(reg::INT_PIN_CFG, 0)?;
+        self.write_reg(reg::INT_ENABLE, bits::DATA_RDY)
+    }
+
+    /// The bus, for a board to recover it (clock SCL until a stuck slave lets go of SDA).
+    /// The driver keeps no state about the bus, so anything done to it is safe here.
+    pub fn bus_mut(&mut self) -> &mut I {
+        &mut self.i2c
+    }
+
     /// Reads `INT_STATUS`, which clears it and releases the INT pin.
     pub fn read_interrupt_status(&mut self) -> Result<InterruptStatus, Error<I::Error>> {
         Ok(InterruptStatus(self.read_reg(reg::INT_STATUS)?))

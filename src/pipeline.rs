@@ -21,7 +21,7 @@ use crate::rate::SampleRate;
 use crate::rest::{RestDetector, RestThresholds};
 use crate::sample::{AccelRange, GyroRange, RawSample};
 use crate::stance::{StanceDetector, StanceThresholds};
-use crate::stride::{Stride, StrideTracker};
+use crate::stride::{Stride, StrideTracker, MAX_MOVEMENT_SAMPLES};
 
 /// Capacity of the mean filter; the window used is the power of two nearest
 /// [`MEAN_FILTER_MS`] at the sample rate, at most this.
@@ -85,14 +85,15 @@ const fn log2_nearest(n: u32) -> u32 {
     }
 }
 
-/// From raw samples to strides.
+/// From raw samples to strides, with a movement buffer of `M` samples
+/// ([`MAX_MOVEMENT_SAMPLES`] by default, 6 KiB; see [`Pipeline::sized`]).
 #[derive(Clone, Debug)]
-pub struct Pipeline {
+pub struct Pipeline<const M: usize = MAX_MOVEMENT_SAMPLES> {
     filter: MeanFilter<MEAN_FILTER_CAPACITY>,
     rest: RestDetector,
     frame: FootFrameEstimator,
     stance: StanceDetector,
-    tracker: StrideTracker,
+    tracker: StrideTracker<M>,
     rate: SampleRate,
     model: Model,
     settings: Settings,
@@ -113,8 +114,18 @@ pub struct Pipeline {
 }
 
 impl Pipeline {
-    /// A pipeline for data described by `config`.
+    /// A pipeline for data described by `config`, with the default movement buffer.
     pub const fn new(config: Config) -> Self {
+        Self::sized(config)
+    }
+}
+
+impl<const M: usize> Pipeline<M> {
+    /// A pipeline for data described by `config` that keeps at most `M` samples of a
+    /// movement (6 bytes each). A board short of RAM picks fewer: `M` must cover the
+    /// longest walking movement at its rate (about 1 s), or strides come out
+    /// [`crate::stride::StrideFlags::TOO_LONG`].
+    pub const fn sized(config: Config) -> Self {
         let filter =
             MeanFilter::with_len_log2(log2_nearest(config.rate.samples_in_ms(MEAN_FILTER_MS)));
         let rest = RestDetector::new(RestThresholds::new(config.rate, config.accel, config.gyro));
@@ -126,7 +137,7 @@ impl Pipeline {
             rest,
             frame: FootFrameEstimator::new(config.rate, config.accel),
             stance,
-            tracker: StrideTracker::new(config.rate, config.gyro, config.phases),
+            tracker: StrideTracker::sized(config.rate, config.gyro, config.phases),
             rate: config.rate,
             model: config.model,
             settings: config.settings,
@@ -158,9 +169,16 @@ impl Pipeline {
         self.next
     }
 
-    /// The foot frame found so far, if any.
+    /// The foot frame found so far, if any: set once the clip has been still for
+    /// [`crate::foot_frame::FIRST_FRAME_AFTER_MS`], its heading learnt from the first steps.
     pub const fn foot_frame(&self) -> Option<crate::foot_frame::FootFrame> {
         self.frame.frame()
+    }
+
+    /// Gyroscope bias measured over the last rest period, counts of the configured range
+    /// (zero until the clip has been still once).
+    pub const fn gyro_bias(&self) -> [i32; 3] {
+        self.frame.gyro_bias()
     }
 
     /// Feeds one sample; returns a stride when one can be reported.

@@ -64,8 +64,8 @@ impl RestThresholds {
 pub struct RestDetector {
     thresholds: RestThresholds,
     accel: [[i16; 3]; WINDOW_CAPACITY],
-    accel_sq: [i64; WINDOW_CAPACITY],
-    gyro_sq: [i64; WINDOW_CAPACITY],
+    /// |ω|² of each sample, counts² (≤ 3·2³⁰, fits a `u32`).
+    gyro_sq: [u32; WINDOW_CAPACITY],
     sum_a: [i64; 3],
     sum_a_sq: i64,
     sum_g_sq: i64,
@@ -79,7 +79,6 @@ impl RestDetector {
         RestDetector {
             thresholds,
             accel: [[0; 3]; WINDOW_CAPACITY],
-            accel_sq: [0; WINDOW_CAPACITY],
             gyro_sq: [0; WINDOW_CAPACITY],
             sum_a: [0; 3],
             sum_a_sq: 0,
@@ -106,22 +105,26 @@ impl RestDetector {
         let w = self.thresholds.window as usize;
         let slot = self.head & (WINDOW_CAPACITY - 1);
         let leaving = (self.head + WINDOW_CAPACITY - w) & (WINDOW_CAPACITY - 1);
-        let a_sq: i64 = accel.iter().map(|&v| v as i64 * v as i64).sum();
-        let g_sq: i64 = gyro.iter().map(|&v| v as i64 * v as i64).sum();
+        let square = |v: &[i16; 3]| -> u32 {
+            v.iter()
+                .map(|&x| x.unsigned_abs() as u32 * x.unsigned_abs() as u32)
+                .sum()
+        };
+        let a_sq = square(&accel) as i64;
+        let g_sq = square(&gyro);
         self.accel[slot] = accel;
-        self.accel_sq[slot] = a_sq;
         self.gyro_sq[slot] = g_sq;
         for (s, &v) in self.sum_a.iter_mut().zip(accel.iter()) {
             *s += v as i64;
         }
         self.sum_a_sq += a_sq;
-        self.sum_g_sq += g_sq;
+        self.sum_g_sq += g_sq as i64;
         if self.seen as usize >= w {
             for (s, &v) in self.sum_a.iter_mut().zip(self.accel[leaving].iter()) {
                 *s -= v as i64;
             }
-            self.sum_a_sq -= self.accel_sq[leaving];
-            self.sum_g_sq -= self.gyro_sq[leaving];
+            self.sum_a_sq -= square(&self.accel[leaving]) as i64;
+            self.sum_g_sq -= self.gyro_sq[leaving] as i64;
         } else {
             self.seen += 1;
         }

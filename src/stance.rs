@@ -158,7 +158,8 @@ pub struct StanceDetector {
     thresholds: StanceThresholds,
     /// Deflated vertical and sagittal acceleration.
     ring: [[i32; 2]; RING_CAPACITY],
-    gyro: [i64; RING_CAPACITY],
+    /// |ω|² of each sample, counts² (≤ 3·2³⁰, fits a `u32`).
+    gyro: [u32; RING_CAPACITY],
     sum: [[i64; 2]; 3],
     sum_sq: [[i64; 2]; 3],
     gyro_sum: i64,
@@ -205,7 +206,10 @@ impl StanceDetector {
         self.seen = self.seen.saturating_add(1);
         let slot = |i: u32| i as usize & (RING_CAPACITY - 1);
         self.ring[slot(n)] = [deflate(foot[2]), deflate(foot[0])];
-        self.gyro[slot(n)] = gyro.iter().map(|&v| v as i64 * v as i64).sum();
+        self.gyro[slot(n)] = gyro
+            .iter()
+            .map(|&v| v.unsigned_abs() as u32 * v.unsigned_abs() as u32)
+            .sum();
         let big = self.thresholds.half[2];
         // The centre is `big` inputs back; window k spans centre ± half[k].
         let centre = n.wrapping_sub(big);
@@ -222,7 +226,7 @@ impl StanceDetector {
                     self.sum_sq[k][a] += x as i64 * x as i64;
                 }
                 if k == 1 {
-                    self.gyro_sum += self.gyro[slot(entering)];
+                    self.gyro_sum += self.gyro[slot(entering)] as i64;
                     for (sorted, &x) in self.sorted.iter_mut().zip(v.iter()) {
                         sorted.insert(x);
                     }
@@ -235,7 +239,7 @@ impl StanceDetector {
                     self.sum_sq[k][a] -= x as i64 * x as i64;
                 }
                 if k == 1 {
-                    self.gyro_sum -= self.gyro[slot(leaving)];
+                    self.gyro_sum -= self.gyro[slot(leaving)] as i64;
                     for (sorted, &x) in self.sorted.iter_mut().zip(v.iter()) {
                         sorted.remove(x);
                     }

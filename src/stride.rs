@@ -24,8 +24,9 @@
 //! A gap in the samples drops the movement in progress: no stride is ever emitted across one.
 //!
 //! Streaming and bounded: the only per-stride memory is the movement's foot-frame
-//! acceleration, [`MAX_MOVEMENT_SAMPLES`] samples; a longer movement is still closed at the
-//! next stance but flagged [`StrideFlags::TOO_LONG`] and split on what was kept.
+//! acceleration, a buffer of `M` samples ([`MAX_MOVEMENT_SAMPLES`] unless a board with
+//! little RAM picks fewer); a longer movement is still closed at the next stance but flagged
+//! [`StrideFlags::TOO_LONG`] and split on what was kept.
 
 use heapless::Vec;
 
@@ -38,8 +39,8 @@ use crate::rest::RestSums;
 use crate::sample::{GyroRange, RawSample};
 use crate::zupt::ZuptIntegrator;
 
-/// Capacity of the movement buffer: 1.024 s at 1 kHz, 5 s at 204.8 Hz, 10 s at 100 Hz
-/// (a walking movement, heel-off to foot-flat, lasts 0.5–1 s).
+/// Default capacity of the movement buffer: 1.024 s at 1 kHz, 5 s at 204.8 Hz, 10 s at
+/// 100 Hz (a walking movement, heel-off to foot-flat, lasts 0.5–1 s). 6 KiB of state.
 pub const MAX_MOVEMENT_SAMPLES: usize = 1024;
 /// A movement shorter than this is a wobble of a foot still on the ground, not a step.
 pub const MIN_MOVEMENT_MS: u32 = 150;
@@ -54,7 +55,7 @@ pub struct StrideFlags(pub u8);
 impl StrideFlags {
     /// A sample of the movement sat at a rail of its range: the length is uncertain.
     pub const SATURATED: u8 = 1 << 0;
-    /// The movement overflowed [`MAX_MOVEMENT_SAMPLES`]: not a walking stride.
+    /// The movement overflowed the movement buffer: not a walking stride.
     pub const TOO_LONG: u8 = 1 << 1;
     /// The stride starts from a stance longer than [`MAX_STANCE_IN_STRIDE_MS`]: the first
     /// step after standing (informational).
@@ -117,9 +118,9 @@ enum State {
     Moving,
 }
 
-/// Turns stance decisions into strides.
+/// Turns stance decisions into strides, keeping at most `M` samples of a movement.
 #[derive(Clone, Debug)]
-pub struct StrideTracker {
+pub struct StrideTracker<const M: usize = MAX_MOVEMENT_SAMPLES> {
     state: State,
     min_movement: u32,
     max_stance: u32,
@@ -127,7 +128,7 @@ pub struct StrideTracker {
     stance_start: u32,
     heel_off: u32,
     stance_sums: RestSums,
-    movement: Vec<[i16; CHANNELS], MAX_MOVEMENT_SAMPLES>,
+    movement: Vec<[i16; CHANNELS], M>,
     flags: u8,
     next_index: u32,
     phase_method: PhaseMethod,
@@ -137,8 +138,16 @@ pub struct StrideTracker {
 }
 
 impl StrideTracker {
-    /// A tracker for a sample rate and gyro range, splitting phases with `phase_method`.
+    /// A tracker with the default movement buffer ([`MAX_MOVEMENT_SAMPLES`]) for a sample
+    /// rate and gyro range, splitting phases with `phase_method`.
     pub const fn new(rate: SampleRate, gyro: GyroRange, phase_method: PhaseMethod) -> Self {
+        Self::sized(rate, gyro, phase_method)
+    }
+}
+
+impl<const M: usize> StrideTracker<M> {
+    /// A tracker with a movement buffer of `M` samples.
+    pub const fn sized(rate: SampleRate, gyro: GyroRange, phase_method: PhaseMethod) -> Self {
         StrideTracker {
             state: State::Unprimed,
             min_movement: rate.samples_in_ms(MIN_MOVEMENT_MS),
