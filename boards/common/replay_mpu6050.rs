@@ -123,3 +123,10 @@ impl i2c::I2c<SevenBitAddress> for ReplayMpu6050 {
         Ok(())
     }
 }
+
+impl crate::imu_sampler::BusRecovery for ReplayMpu6050 {
+    /// An emulated bus cannot get stuck.
+    fn recover_bus(&mut self) -> bool {
+        false
+    }
+}

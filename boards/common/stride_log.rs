@@ -1,10 +1,28 @@
-//! The per-stride log line and the end-of-run summary, shared by every board.
+//! What every board reports, on both of its outputs: defmt (RTT with a probe, semihosting in
+//! QEMU) and the serial line protocol of [`crate::serial_line`] (any `fmt::Write`; boards
+//! without a UART pass [`NoSerial`]).
 //!
-//! Format (one defmt line per stride; the host's bit-exact test parses it):
+//! defmt format (one line per stride; the host's bit-exact test parses it):
 //! `stride <index> t=<start ms> dur=<ms> len=<mm> climb=<mm> phases=<stance>/<push-off>/<swing>/<heel-strike> ms flags=<bits> idx=<start>,<heel_off>,<toe_off>,<heel_strike>,<end>`
 
+use core::fmt::Write;
+
+use gaitclip::models::Model;
 use gaitclip::rate::SampleRate;
 use gaitclip::stride::Stride;
+
+use crate::imu_sampler::Counters;
+use crate::serial_line;
+use crate::startup::StartupEvent;
+
+/// A serial output that discards everything (boards without a UART).
+pub struct NoSerial;
+
+impl Write for NoSerial {
+    fn write_str(&mut self, _: &str) -> core::fmt::Result {
+        Ok(())
+    }
+}
 
 /// Running totals and the formatting of strides.
 pub struct StrideLog {
@@ -23,8 +41,20 @@ impl StrideLog {
         }
     }
 
+    /// The banner of the serial protocol (defmt logs its own).
+    pub fn banner(&self, board: &str, model: Model, serial: &mut impl Write) {
+        defmt::info!(
+            "gaitclip {=str} on {=str}: {=u32} mHz, model {=str}",
+            env!("CARGO_PKG_VERSION"),
+            board,
+            self.rate.millihertz(),
+            model.name()
+        );
+        let _ = serial_line::banner(serial, board, self.rate, model);
+    }
+
     /// Logs one stride.
-    pub fn stride(&mut self, s: &Stride) {
+    pub fn stride(&mut self, s: &Stride, serial: &mut impl Write) {
         let ms = |a: u32, b: u32| self.rate.ms_of_samples(b.wrapping_sub(a));
         self.strides += 1;
         self.distance_mm += s.length_mm as u64;
@@ -46,17 +76,91 @@ impl StrideLog {
             s.heel_strike,
             s.end
         );
+        let _ = serial_line::stride(serial, self.rate, s);
     }
 
-    /// Logs the summary at the end of a run.
-    pub fn summary(&self, samples: u32, overruns: u32, bus_errors: u32) {
+    /// Reports a step of the start-up calibration.
+    pub fn startup(&self, e: StartupEvent, serial: &mut impl Write) {
+        match e {
+            StartupEvent::HoldStill { waited_ms } => {
+                defmt::info!(
+                    "hold still: waiting for the clip to rest ({=u32} ms so far)",
+                    waited_ms
+                );
+                let _ = serial_line::comment(
+                    serial,
+                    format_args!(
+                        "hold still: waiting for the clip to rest ({} ms so far)",
+                        waited_ms
+                    ),
+                );
+            }
+            StartupEvent::Still {
+                gyro_bias_mdps: b,
+                gravity_mg,
+                plausible,
+            } => {
+                defmt::info!(
+                    "still: gyro_bias_mdps={=i32},{=i32},{=i32} gravity_mg={=i32}",
+                    b[0],
+                    b[1],
+                    b[2],
+                    gravity_mg
+                );
+                let _ = serial_line::comment(
+                    serial,
+                    format_args!(
+                        "still: gyro_bias_mdps={},{},{} gravity_mg={}",
+                        b[0], b[1], b[2], gravity_mg
+                    ),
+                );
+                if !plausible {
+                    defmt::warn!("the sensor reads outside its datasheet tolerance: check the part and its range");
+                    let _ = serial_line::comment(
+                        serial,
+                        format_args!("warning: the sensor reads outside its datasheet tolerance: check the part and its range"),
+                    );
+                }
+            }
+            StartupEvent::HeadingKnown => {
+                defmt::info!("foot frame known: measuring strides");
+                let _ = serial_line::comment(
+                    serial,
+                    format_args!("foot frame known: measuring strides"),
+                );
+            }
+        }
+    }
+
+    /// Reports a gap in the samples.
+    pub fn gap(&self, samples: u32, serial: &mut impl Write) {
+        defmt::warn!(
+            "gap of {=u32} samples: the stride in progress is dropped",
+            samples
+        );
+        let _ = serial_line::comment(
+            serial,
+            format_args!(
+                "gap samples={}: the stride in progress is dropped",
+                samples
+            ),
+        );
+    }
+
+    /// Logs the status (periodically, and at the end of a run).
+    pub fn summary(&self, samples: u32, c: &Counters, serial: &mut impl Write) {
         defmt::println!(
-            "summary strides={=u32} distance_mm={=u64} samples={=u32} overruns={=u32} bus_errors={=u32}",
+            "summary strides={=u32} distance_mm={=u64} samples={=u32} overruns={=u32} bus_errors={=u32} restarts={=u32} fifo_overflows={=u32} silences={=u32} lost_samples={=u32}",
             self.strides,
             self.distance_mm,
             samples,
-            overruns,
-            bus_errors
+            c.overruns,
+            c.bus_errors,
+            c.restarts,
+            c.fifo_overflows,
+            c.silences,
+            c.lost_samples
         );
+        let _ = serial_line::status(serial, samples, self.strides, self.distance_mm, c);
     }
 }

@@ -1,0 +1,276 @@
+//! The sensor side of every board: what the data-ready interrupt does.
+//!
+//! Each board calls [`ImuSampler::on_data_ready`] from the interrupt of the MPU6050's INT
+//! pin (the emulated boards from a timer standing in for it). The sampler reads the sensor,
+//! either one 14-byte burst per data-ready ([`ReadMode::PerSample`]) or the FIFO every few
+//! pulses ([`ReadMode::Fifo`], fewer bus transactions and wake-ups of the I2C peripheral),
+//! and hands [`Item`]s to the board's queue. Nothing is lost silently:
+//!
+//! - a failed read is counted and retried at once, [`RETRIES`] times;
+//! - a sample period whose read still fails becomes part of a [`Item::Gap`] (per-sample
+//!   mode; in FIFO mode the samples wait in the FIFO and the next pulse tries again);
+//! - after [`RESTART_AFTER`] failed periods in a row the bus is recovered (the board clocks
+//!   SCL, [`BusRecovery`]) and the sensor re-initialised; what it lost meanwhile is a gap;
+//! - a FIFO overflow, or a queue with no room, is a gap of the samples it cost;
+//! - a sensor that stops pulsing altogether is found by the board's watchdog, which calls
+//!   [`ImuSampler::on_silence`].
+//!
+//! Board glue, shared: generic over the bus and delay, so the host tests drive it with
+//! `embedded-hal-mock`.
+
+use embedded_hal::delay::DelayNs;
+use embedded_hal::i2c::I2c;
+use gaitclip::mpu6050::{self, Mpu6050};
+use gaitclip::sample::RawSample;
+
+/// Immediate retries of a failed read.
+pub const RETRIES: u32 = 2;
+/// Failed sample periods in a row after which the bus is recovered and the sensor set up
+/// again.
+pub const RESTART_AFTER: u32 = 3;
+/// Most samples read from the FIFO in one burst (the sampler's buffer, 14 B each).
+pub const FIFO_BURST: usize = 16;
+
+/// What the sample interrupt hands to the main loop.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Item {
+    /// One sample, in order.
+    Sample(RawSample),
+    /// This many sample periods were lost here: the pipeline drops the stride in progress
+    /// instead of measuring across the hole.
+    Gap(u32),
+}
+
+/// How the sensor is read.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum ReadMode {
+    /// INT latched on data ready; every pulse reads the 14 data registers.
+    PerSample,
+    /// INT pulses on data ready and is only counted; every `batch` pulses the FIFO is read
+    /// in one burst (at most [`FIFO_BURST`] samples).
+    Fifo {
+        /// Pulses per FIFO read (1..=[`FIFO_BURST`]).
+        batch: u8,
+    },
+}
+
+/// A board's way to free a stuck I2C bus.
+pub trait BusRecovery {
+    /// Clocks SCL (nine pulses and a STOP) so that a slave holding SDA low lets go;
+    /// returns whether the board could do it.
+    fn recover_bus(&mut self) -> bool;
+}
+
+/// What went wrong so far, for the summary line.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct Counters {
+    /// Failed bus transactions (every attempt counts).
+    pub bus_errors: u32,
+    /// Sensor re-initialisations after repeated failures or silence.
+    pub restarts: u32,
+    /// Bus recoveries (SCL clocked) that the board performed.
+    pub recoveries: u32,
+    /// FIFO overflows (or misaligned FIFO counts) found.
+    pub fifo_overflows: u32,
+    /// Watchdog calls: the sensor stopped pulsing.
+    pub silences: u32,
+    /// Items the queue had no room for.
+    pub overruns: u32,
+    /// Sample periods reported as gaps.
+    pub lost_samples: u32,
+}
+
+/// The sensor, its settings and the fault bookkeeping.
+pub struct ImuSampler<I, D> {
+    imu: Mpu6050<I>,
+    delay: D,
+    config: mpu6050::Config,
+    mode: ReadMode,
+    /// Data-ready pulses whose sample is still in the FIFO (FIFO mode).
+    unread: u32,
+    /// Sample periods in a row whose read failed.
+    failed_periods: u32,
+    /// Lost periods not yet handed to the queue.
+    pending_gap: u32,
+    counters: Counters,
+}
+
+impl<I, D> ImuSampler<I, D>
+where
+    I: I2c + BusRecovery,
+    D: DelayNs,
+{
+    /// Initialises the sensor for `config` and its interrupt for `mode`. On error the bus
+    /// and delay are handed back with it, for the board to report and retry.
+    #[allow(clippy::type_complexity)]
+    pub fn start(
+        imu: Mpu6050<I>,
+        delay: D,
+        config: mpu6050::Config,
+        mode: ReadMode,
+    ) -> Result<Self, (Mpu6050<I>, D, mpu6050::Error<I::Error>)> {
+        let mut s = ImuSampler {
+            imu,
+            delay,
+            config,
+            mode,
+            unread: 0,
+            failed_periods: 0,
+            pending_gap: 0,
+            counters: Counters::default(),
+        };
+        match s.setup() {
+            Ok(()) => Ok(s),
+            Err(e) => Err((s.imu, s.delay, e)),
+        }
+    }
+
+    /// The fault counters.
+    pub const fn counters(&self) -> Counters {
+        self.counters
+    }
+
+    /// Counts an item the queue had no room for: it becomes part of the next gap.
+    fn lost(&mut self, periods: u32) {
+        self.pending_gap = self.pending_gap.saturating_add(periods);
+        self.counters.lost_samples = self.counters.lost_samples.saturating_add(periods);
+    }
+
+    /// Hands `item` to `push` (which returns `false` when the queue is full), reporting any
+    /// pending gap first; what does not fit joins the gap.
+    fn emit(&mut self, push: &mut impl FnMut(Item) -> bool, item: Item) {
+        if self.pending_gap > 0 {
+            if !push(Item::Gap(self.pending_gap)) {
+                self.counters.overruns = self.counters.overruns.saturating_add(1);
+                if let Item::Sample(_) = item {
+                    self.lost(1);
+                }
+                return;
+            }
+            self.pending_gap = 0;
+        }
+        if !push(item) {
+            self.counters.overruns = self.counters.overruns.saturating_add(1);
+            if let Item::Sample(_) = item {
+                self.lost(1);
+            }
+        }
+    }
+
+    /// The data-ready interrupt: reads what is due and hands it to `push`.
+    pub fn on_data_ready(&mut self, push: &mut impl FnMut(Item) -> bool) {
+        match self.mode {
+            ReadMode::PerSample => self.read_one(push),
+            ReadMode::Fifo { batch } => {
+                self.unread = self.unread.saturating_add(1);
+                if self.unread >= batch.max(1) as u32 || self.failed_periods > 0 {
+                    self.read_fifo(push);
+                }
+            }
+        }
+    }
+
+    /// The board's watchdog found no data-ready pulse for `periods` sample periods: the
+    /// sensor was reset or lost power. They become a gap and the sensor is set up again.
+    pub fn on_silence(&mut self, periods: u32, push: &mut impl FnMut(Item) -> bool) {
+        self.counters.silences = self.counters.silences.saturating_add(1);
+        let lost = periods.saturating_add(core::mem::take(&mut self.unread));
+        self.lost(lost);
+        self.restart();
+        if self.pending_gap > 0 && push(Item::Gap(self.pending_gap)) {
+            self.pending_gap = 0;
+        }
+    }
+
+    fn read_one(&mut self, push: &mut impl FnMut(Item) -> bool) {
+        for _ in 0..=RETRIES {
+            match self.imu.read_sample() {
+                Ok(s) => {
+                    self.failed_periods = 0;
+                    self.emit(push, Item::Sample(s));
+                    return;
+                }
+                Err(_) => self.counters.bus_errors = self.counters.bus_errors.saturating_add(1),
+            }
+        }
+        // The sample of this period is gone (the registers hold only the newest).
+        self.lost(1);
+        self.period_failed();
+    }
+
+    fn read_fifo(&mut self, push: &mut impl FnMut(Item) -> bool) {
+        let mut buf = [RawSample::default(); FIFO_BURST];
+        let mut attempts = 0;
+        // More than one burst when the reads fell behind; bounded by what was pulsed.
+        let mut bursts = self.unread as usize / FIFO_BURST + 1;
+        while bursts > 0 {
+            match self.imu.read_fifo(&mut buf) {
+                Ok(n) => {
+                    self.failed_periods = 0;
+                    self.unread = self.unread.saturating_sub(n as u32);
+                    for s in &buf[..n] {
+                        self.emit(push, Item::Sample(*s));
+                    }
+                    if n < FIFO_BURST {
+                        // Pulses counted but not in the FIFO: none are waiting any more.
+                        self.unread = 0;
+                        return;
+                    }
+                    bursts -= 1;
+                }
+                Err(mpu6050::Error::FifoOverflow) | Err(mpu6050::Error::FifoMisaligned(_)) => {
+                    // The FIFO was reset: everything pulsed since the last read is gone.
+                    self.counters.fifo_overflows = self.counters.fifo_overflows.saturating_add(1);
+                    let lost = core::mem::take(&mut self.unread);
+                    self.lost(lost);
+                    return;
+                }
+                Err(_) => {
+                    self.counters.bus_errors = self.counters.bus_errors.saturating_add(1);
+                    attempts += 1;
+                    if attempts > RETRIES {
+                        // The samples stay in the FIFO; the next pulse tries again.
+                        self.period_failed();
+                        return;
+                    }
+                }
+            }
+        }
+    }
+
+    fn period_failed(&mut self) {
+        self.failed_periods = self.failed_periods.saturating_add(1);
+        if self.failed_periods >= RESTART_AFTER {
+            // Re-initialising resets the FIFO: samples waiting there are lost too.
+            let lost = core::mem::take(&mut self.unread);
+            self.lost(lost);
+            self.restart();
+        }
+    }
+
+    /// Recovers the bus and sets the sensor up again; on failure the next failed period
+    /// tries again.
+    fn restart(&mut self) {
+        if self.imu.bus_mut().recover_bus() {
+            self.counters.recoveries = self.counters.recoveries.saturating_add(1);
+        }
+        match self.setup() {
+            Ok(()) => {
+                self.counters.restarts = self.counters.restarts.saturating_add(1);
+                self.failed_periods = 0;
+            }
+            Err(_) => self.counters.bus_errors = self.counters.bus_errors.saturating_add(1),
+        }
+    }
+
+    fn setup(&mut self) -> Result<(), mpu6050::Error<I::Error>> {
+        self.imu.init(&mut self.delay, &self.config)?;
+        match self.mode {
+            ReadMode::PerSample => self.imu.enable_data_ready_interrupt(),
+            ReadMode::Fifo { .. } => {
+                self.imu.enable_fifo()?;
+                self.imu.enable_data_ready_pulse()
+            }
+        }
+    }
+}

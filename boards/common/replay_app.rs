@@ -1,0 +1,201 @@
+//! The firmware of the emulated boards, which differ only in their sample timer.
+//!
+//! A timer interrupts at the trace's sample rate and stands in for the MPU6050's INT pin:
+//! it pulses once per sample of the stored trace. Its handler ([`on_data_ready`]) runs the
+//! shared [`ImuSampler`] on the emulated sensor ([`ReplayMpu6050`], the real driver on top),
+//! which pushes into an SPSC queue. The main loop ([`run`]) drains the queue through the
+//! pipeline, reports start-up, strides and gaps, and sleeps with `wfi` when the queue is
+//! empty. When the trace ends it logs a summary and exits QEMU through semihosting with
+//! status 0; a panic or HardFault exits with status 1 ([`fail`]).
+
+use core::cell::RefCell;
+use core::sync::atomic::{AtomicBool, AtomicU32, Ordering};
+
+use cortex_m::interrupt::{self as irq, Mutex};
+use cortex_m_semihosting::debug::{self, EXIT_FAILURE, EXIT_SUCCESS};
+use embedded_hal::delay::DelayNs;
+use gaitclip::mpu6050::{self, Address, Mpu6050};
+use gaitclip::pipeline::{Config, Pipeline};
+use gaitclip::rate::SampleRate;
+use gaitclip::sample::{AccelRange, GyroRange, SAMPLE_BYTES};
+use heapless::spsc::{Producer, Queue};
+
+use crate::imu_sampler::{Counters, ImuSampler, Item, ReadMode};
+use crate::replay_mpu6050::ReplayMpu6050;
+use crate::startup::Startup;
+use crate::stride_log::{NoSerial, StrideLog};
+use crate::trace;
+
+/// Samples the queue holds between the interrupt and the main loop: 32 = 160 ms at 200 Hz,
+/// more than one stride's processing takes on either core.
+pub const QUEUE_LEN: usize = 32;
+/// Samples in the stored trace: the number of data-ready pulses the timer gives.
+pub const TRACE_SAMPLES: u32 = (trace::REGISTERS.len() / SAMPLE_BYTES) as u32;
+
+const fn unwrap<T: Copy>(v: Option<T>) -> T {
+    match v {
+        Some(v) => v,
+        None => panic!("the stored trace has an unsupported rate or range"),
+    }
+}
+
+/// The stored trace's sample rate (checked at compile time).
+pub const RATE: SampleRate = unwrap(SampleRate::from_millihertz(trace::RATE_MILLIHERTZ));
+const ACCEL: AccelRange = unwrap(AccelRange::from_afs_sel(trace::ACCEL_AFS_SEL));
+const GYRO: GyroRange = unwrap(GyroRange::from_fs_sel(trace::GYRO_FS_SEL));
+const SENSOR: mpu6050::Config = mpu6050::Config {
+    rate: unwrap(mpu6050::OutputRate::from_hz(
+        (trace::RATE_MILLIHERTZ / 1000) as u16,
+    )),
+    accel: ACCEL,
+    gyro: GYRO,
+};
+
+/// Busy-wait delay for the sensor's reset time; the emulated sensor needs none, a real one
+/// 100 ms, and a busy loop is honest about what it costs.
+pub struct SpinDelay {
+    /// Core clock, cycles per µs.
+    pub cycles_per_us: u32,
+}
+
+impl DelayNs for SpinDelay {
+    fn delay_ns(&mut self, ns: u32) {
+        cortex_m::asm::delay((ns / 1000).saturating_mul(self.cycles_per_us).max(1));
+    }
+}
+
+type Sampler = ImuSampler<ReplayMpu6050, SpinDelay>;
+
+static PRODUCER: Mutex<RefCell<Option<Producer<'static, Item>>>> = Mutex::new(RefCell::new(None));
+static SAMPLER: Mutex<RefCell<Option<Sampler>>> = Mutex::new(RefCell::new(None));
+static PULSES: AtomicU32 = AtomicU32::new(0);
+static TRACE_DONE: AtomicBool = AtomicBool::new(false);
+
+/// The board's sample timer.
+pub trait SampleTimer {
+    /// Starts periodic interrupts at `millihertz`.
+    fn start_periodic(&self, millihertz: u32);
+    /// Stops them.
+    fn stop(&self);
+}
+
+/// Runs the trace through the pipeline (movement buffer of `M` samples) and exits QEMU.
+/// `unmask` enables the timer's interrupt in the NVIC.
+pub fn run<const M: usize>(
+    board: &str,
+    cycles_per_us: u32,
+    timer: &impl SampleTimer,
+    unmask: impl FnOnce(),
+) -> ! {
+    let imu = Mpu6050::new(
+        ReplayMpu6050::new(Address::Ad0Low.bits(), trace::REGISTERS),
+        Address::Ad0Low,
+    );
+    let sampler = match Sampler::start(
+        imu,
+        SpinDelay { cycles_per_us },
+        SENSOR,
+        ReadMode::PerSample,
+    ) {
+        Ok(s) => s,
+        Err((_, _, e)) => {
+            defmt::error!("MPU6050 init failed: {}", defmt::Debug2Format(&e));
+            fail();
+        }
+    };
+    let config = Config::new(RATE, ACCEL, GYRO);
+    let mut log = StrideLog::new(RATE);
+    let mut serial = NoSerial;
+    log.banner(board, config.model, &mut serial);
+    defmt::info!(
+        "replaying {=u32} samples of the stored trace through the emulated MPU6050",
+        TRACE_SAMPLES
+    );
+
+    let Some(queue) = cortex_m::singleton!(: Queue<Item, QUEUE_LEN> = Queue::new()) else {
+        fail();
+    };
+    let (producer, mut consumer) = queue.split();
+    irq::free(|cs| {
+        PRODUCER.borrow(cs).replace(Some(producer));
+        SAMPLER.borrow(cs).replace(Some(sampler));
+    });
+    timer.start_periodic(trace::RATE_MILLIHERTZ);
+    unmask();
+
+    let mut pipeline = Pipeline::<M>::sized(config);
+    let mut startup = Startup::new(RATE, GYRO);
+    let mut samples = 0u32;
+    loop {
+        while let Some(item) = consumer.dequeue() {
+            match item {
+                Item::Sample(s) => {
+                    samples = samples.wrapping_add(1);
+                    let stride = pipeline.process(&s);
+                    if let Some(e) = startup.update(&pipeline) {
+                        log.startup(e, &mut serial);
+                    }
+                    if let Some(stride) = stride {
+                        log.stride(&stride, &mut serial);
+                    }
+                }
+                Item::Gap(n) => {
+                    log.gap(n, &mut serial);
+                    if let Some(stride) = pipeline.gap(n) {
+                        log.stride(&stride, &mut serial);
+                    }
+                }
+            }
+        }
+        if TRACE_DONE.load(Ordering::Acquire) && !consumer.ready() {
+            timer.stop();
+            for stride in pipeline.finish().iter().flatten() {
+                log.stride(stride, &mut serial);
+            }
+            let counters = irq::free(|cs| {
+                SAMPLER
+                    .borrow(cs)
+                    .borrow()
+                    .as_ref()
+                    .map_or(Counters::default(), |s| s.counters())
+            });
+            log.summary(samples, &counters, &mut serial);
+            debug::exit(EXIT_SUCCESS);
+        }
+        // Sleep until the next interrupt. Interrupts are masked while checking the queue so
+        // a sample that arrives between the check and `wfi` still wakes the core (WFI wakes
+        // on a pending interrupt even with PRIMASK set).
+        irq::disable();
+        if !consumer.ready() && !TRACE_DONE.load(Ordering::Acquire) {
+            cortex_m::asm::wfi();
+        }
+        // Note(unsafe): re-enables the interrupts disabled just above; no critical section
+        // spans this point.
+        unsafe { irq::enable() };
+    }
+}
+
+/// The timer's interrupt, after the board acknowledged it: one data-ready pulse of the
+/// emulated sensor, or the end of the trace. Returns `false` when the timer should stop.
+pub fn on_data_ready() -> bool {
+    let pulse = PULSES.fetch_add(1, Ordering::Relaxed);
+    if pulse >= TRACE_SAMPLES {
+        TRACE_DONE.store(true, Ordering::Release);
+        return false;
+    }
+    irq::free(|cs| {
+        let mut sampler = SAMPLER.borrow(cs).borrow_mut();
+        let mut producer = PRODUCER.borrow(cs).borrow_mut();
+        if let (Some(sampler), Some(producer)) = (sampler.as_mut(), producer.as_mut()) {
+            sampler.on_data_ready(&mut |item| producer.enqueue(item).is_ok());
+        }
+    });
+    true
+}
+
+/// Exits QEMU with a failure status.
+pub fn fail() -> ! {
+    debug::exit(EXIT_FAILURE);
+    // Without a debugger attached semihosting returns: stop with a fault instead.
+    cortex_m::asm::udf()
+}

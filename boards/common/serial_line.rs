@@ -1,0 +1,97 @@
+//! The serial line protocol: one CSV line per stride, readable with any terminal.
+//!
+//! A board without a debug probe prints this on a UART (115 200 baud, 8N1). Lines end in
+//! `\r\n`. Lines starting with `#` are status for a human (start-up, calibration, faults);
+//! every other line is CSV under the header line that follows the banner:
+//!
+//! ```text
+//! # gaitclip 0.1.0 board=nrf52840-dk rate_mhz=200000 model=huang_svr_fusion
+//! index,t_ms,length_mm,duration_ms,stance_ms,push_off_ms,swing_ms,heel_strike_ms,climb_mm,flags,valid
+//! # hold still: waiting for the clip to rest (2 s)
+//! # still: gyro_bias_mdps=-1220,305,61 gravity_mg=1003
+//! 0,5120,1362,1105,420,150,380,155,3,4,1
+//! # gap samples=12: the stride in progress is dropped
+//! # status samples=24000 strides=96 distance_mm=131012 bus_errors=0 restarts=0 fifo_overflows=0 silences=0 overruns=0 lost_samples=0
+//! ```
+//!
+//! `index` counts strides from 0; `t_ms` is the start of the stride since power-up;
+//! `duration_ms` is the whole stride and the four phase columns add up to it; `flags` is
+//! the bit set of [`gaitclip::stride::StrideFlags`] (1 saturated, 2 too long, 4 from rest,
+//! 8 to rest, 16 turn, 32 phases guessed); `valid` is 0 when a flag makes the length
+//! untrustworthy. `tests-host/tests/serial_line.rs` parses these lines back.
+
+use core::fmt::{self, Write};
+
+use gaitclip::models::Model;
+use gaitclip::rate::SampleRate;
+use gaitclip::stride::Stride;
+
+use crate::imu_sampler::Counters;
+
+/// Longest line this module writes, with its `\r\n` (the status line with every counter
+/// at its maximum): the size of a board's line buffer.
+pub const MAX_LINE: usize = 192;
+
+/// The CSV header line.
+pub const HEADER: &str = "index,t_ms,length_mm,duration_ms,stance_ms,push_off_ms,swing_ms,heel_strike_ms,climb_mm,flags,valid";
+
+/// The banner and the CSV header.
+pub fn banner(out: &mut impl Write, board: &str, rate: SampleRate, model: Model) -> fmt::Result {
+    write!(
+        out,
+        "# gaitclip {} board={} rate_mhz={} model={}\r\n{}\r\n",
+        env!("CARGO_PKG_VERSION"),
+        board,
+        rate.millihertz(),
+        model.name(),
+        HEADER
+    )
+}
+
+/// One stride.
+pub fn stride(out: &mut impl Write, rate: SampleRate, s: &Stride) -> fmt::Result {
+    let ms = |a: u32, b: u32| rate.ms_of_samples(b.wrapping_sub(a));
+    write!(
+        out,
+        "{},{},{},{},{},{},{},{},{},{},{}\r\n",
+        s.index,
+        rate.ms_of_samples(s.start),
+        s.length_mm,
+        ms(s.start, s.end),
+        ms(s.start, s.heel_off),
+        ms(s.heel_off, s.toe_off),
+        ms(s.toe_off, s.heel_strike),
+        ms(s.heel_strike, s.end),
+        s.climb_mm,
+        s.flags.0,
+        s.flags.valid() as u8
+    )
+}
+
+/// A status line for a human.
+pub fn comment(out: &mut impl Write, args: fmt::Arguments<'_>) -> fmt::Result {
+    write!(out, "# {args}\r\n")
+}
+
+/// The periodic (and final) status line.
+pub fn status(
+    out: &mut impl Write,
+    samples: u32,
+    strides: u32,
+    distance_mm: u64,
+    c: &Counters,
+) -> fmt::Result {
+    write!(
+        out,
+        "# status samples={} strides={} distance_mm={} bus_errors={} restarts={} fifo_overflows={} silences={} overruns={} lost_samples={}\r\n",
+        samples,
+        strides,
+        distance_mm,
+        c.bus_errors,
+        c.restarts,
+        c.fifo_overflows,
+        c.silences,
+        c.overruns,
+        c.lost_samples
+    )
+}
