@@ -130,6 +130,9 @@ pub struct StrideStats {
 impl StrideStats {
     /// Summarises `movement` (`[vertical, sagittal, magnitude]` per sample) split at the
     /// offsets `toe_off` and `heel_strike` (clamped to the movement, in order).
+    // Not inlined (nor are the splitter and the stride closing): each keeps its
+    // temporaries on the stack only while it runs, which a 16 KiB Cortex-M0 needs.
+    #[inline(never)]
     pub fn measure(movement: &[[i16; CHANNELS]], toe_off: u32, heel_strike: u32) -> Self {
         let len = movement.len();
         let to = (toe_off as usize).min(len);

@@ -65,8 +65,10 @@ pub struct PhaseSplit {
 
 #[derive(Clone, Copy, Debug)]
 struct Extreme {
-    at: u32,
-    value: i32,
+    /// Sample in the movement (movements are capped below 2¹⁶ samples in [`split`]).
+    at: u16,
+    /// g/2048, as in the movement.
+    value: i16,
     axis: u8,
     peak: bool,
 }
@@ -79,12 +81,12 @@ struct Pair {
 
 impl Pair {
     fn magnitude(&self) -> i32 {
-        self.peak.value - self.valley.value
+        self.peak.value as i32 - self.valley.value as i32
     }
 
     /// Centre ×2, for the nearest-crossing search.
     fn centre_x2(&self) -> u32 {
-        self.peak.at + self.valley.at
+        self.peak.at as u32 + self.valley.at as u32
     }
 }
 
@@ -96,12 +98,16 @@ const SAGITTAL: u8 = 1;
 /// the second are ignored); `merge_samples` is
 /// [`MERGE_MS`] at the sample rate. Never panics; a movement of fewer than 3 samples or
 /// without extremes gives its quarter and three-quarter points with `found = false`.
+#[inline(never)] // see StrideStats::measure
 pub fn split<const N: usize>(
     movement: &[[i16; N]],
     method: PhaseMethod,
     merge_samples: u32,
 ) -> PhaseSplit {
     const { assert!(N >= 2, "a movement has vertical and sagittal columns") };
+    // Sample numbers of extremes are kept in 16 bits (6-byte extremes keep the list at
+    // 1.5 KiB, which small boards need); no movement buffer comes near 2¹⁶ samples.
+    let movement = &movement[..movement.len().min(u16::MAX as usize)];
     let len = movement.len() as u32;
     let fallback = PhaseSplit {
         toe_off: len / 4,
@@ -111,12 +117,15 @@ pub fn split<const N: usize>(
     if len < 3 {
         return fallback;
     }
-    let extremes = find_extremes(movement);
+    // Filled in place: returned by value it was copied, twice the 1.5 KiB on the stack.
+    let mut extremes = Vec::new();
+    find_extremes(movement, &mut extremes);
     if extremes.is_empty() {
         return fallback;
     }
     let (c_left, c_right) = kmeans(&extremes, len);
-    let in_left = |e: &Extreme| (e.at * 16).abs_diff(c_left) < (e.at * 16).abs_diff(c_right);
+    let in_left =
+        |e: &Extreme| (e.at as u32 * 16).abs_diff(c_left) < (e.at as u32 * 16).abs_diff(c_right);
     let major = |axis: u8, left: bool| {
         major_pair(
             extremes
@@ -131,16 +140,16 @@ pub fn split<const N: usize>(
     let mut to_refs: Vec<u32, 4> = Vec::new();
     let mut hs_refs: Vec<u32, 4> = Vec::new();
     if let Some(p) = sag_l {
-        let _ = to_refs.push(p.peak.at);
+        let _ = to_refs.push(p.peak.at as u32);
     }
     if let Some(p) = vert_l {
-        let _ = to_refs.push(p.valley.at);
+        let _ = to_refs.push(p.valley.at as u32);
     }
     if let Some(p) = sag_r {
-        let _ = hs_refs.push(p.peak.at);
+        let _ = hs_refs.push(p.peak.at as u32);
     }
     if let Some(p) = vert_r {
-        let _ = hs_refs.push(p.peak.at);
+        let _ = hs_refs.push(p.peak.at as u32);
     }
     if method == PhaseMethod::Augmented {
         let crossing = |pair: Option<Pair>, axis: u8, downward: bool| {
@@ -181,9 +190,8 @@ pub fn split<const N: usize>(
     }
 }
 
-fn find_extremes<const N: usize>(movement: &[[i16; N]]) -> Vec<Extreme, MAX_EXTREMES> {
+fn find_extremes<const N: usize>(movement: &[[i16; N]], out: &mut Vec<Extreme, MAX_EXTREMES>) {
     let min = MIN_EXTREME_MG * crate::foot_frame::FOOT_LSB_PER_G / 1000;
-    let mut out = Vec::new();
     let len = movement.len();
     for axis in [VERTICAL, SAGITTAL] {
         let a = axis as usize;
@@ -205,8 +213,8 @@ fn find_extremes<const N: usize>(movement: &[[i16; N]]) -> Vec<Extreme, MAX_EXTR
             if (peak || valley)
                 && out
                     .push(Extreme {
-                        at: ((i + j) / 2) as u32,
-                        value: v,
+                        at: ((i + j) / 2) as u16,
+                        value: v as i16,
                         axis,
                         peak,
                     })
@@ -217,7 +225,6 @@ fn find_extremes<const N: usize>(movement: &[[i16; N]]) -> Vec<Extreme, MAX_EXTR
             i = j + 1;
         }
     }
-    out
 }
 
 /// Algorithm 1: returns the left and right centres, ×16.
@@ -227,7 +234,7 @@ fn kmeans(extremes: &[Extreme], len: u32) -> (u32, u32) {
         let mut sum = [0u64; 2];
         let mut count = [0u64; 2];
         for e in extremes {
-            let x = e.at * 16;
+            let x = e.at as u32 * 16;
             let k = if x.abs_diff(c[0]) < x.abs_diff(c[1]) {
                 0
             } else {
@@ -270,7 +277,7 @@ fn major_pair<'a>(extremes: impl Iterator<Item = &'a Extreme> + Clone, merge: u3
     let mut major = major?;
     let first = major;
     for pair in pairs {
-        let close = pair.peak.at.abs_diff(first.valley.at) <= merge;
+        let close = pair.peak.at.abs_diff(first.valley.at) as u32 <= merge;
         let distinct = pair.peak.at != first.peak.at;
         if distinct && close && 2 * pair.magnitude() > first.magnitude() {
             if pair.peak.value > major.peak.value {

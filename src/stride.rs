@@ -266,6 +266,7 @@ impl<const M: usize> StrideTracker<M> {
         }
     }
 
+    #[inline(never)] // see StrideStats::measure
     fn close(&mut self, foot_flat: u32) -> Stride {
         let split = phases::split(&self.movement, self.phase_method, self.merge_samples);
         let mut flags = self.flags;
