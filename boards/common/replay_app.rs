@@ -43,6 +43,8 @@ const fn unwrap<T: Copy>(v: Option<T>) -> T {
 pub const RATE: SampleRate = unwrap(SampleRate::from_millihertz(trace::RATE_MILLIHERTZ));
 const ACCEL: AccelRange = unwrap(AccelRange::from_afs_sel(trace::ACCEL_AFS_SEL));
 const GYRO: GyroRange = unwrap(GyroRange::from_fs_sel(trace::GYRO_FS_SEL));
+/// The pipeline's configuration for the stored trace.
+pub const CONFIG: Config = Config::new(RATE, ACCEL, GYRO);
 const SENSOR: mpu6050::Config = mpu6050::Config {
     rate: unwrap(mpu6050::OutputRate::from_hz(
         (trace::RATE_MILLIHERTZ / 1000) as u16,
@@ -79,9 +81,10 @@ pub trait SampleTimer {
     fn stop(&self);
 }
 
-/// Runs the trace through the pipeline (movement buffer of `M` samples) and exits QEMU.
-/// `unmask` enables the timer's interrupt in the NVIC.
+/// Runs the trace through `pipeline` (made from [`CONFIG`]; the board keeps it in a static,
+/// sized for its RAM) and exits QEMU. `unmask` enables the timer's interrupt in the NVIC.
 pub fn run<const M: usize>(
+    pipeline: &mut Pipeline<M>,
     board: &str,
     cycles_per_us: u32,
     timer: &impl SampleTimer,
@@ -103,10 +106,8 @@ pub fn run<const M: usize>(
             fail();
         }
     };
-    let config = Config::new(RATE, ACCEL, GYRO);
     let mut log = StrideLog::new(RATE);
-    let mut serial = NoSerial;
-    log.banner(board, config.model, &mut serial);
+    log.banner(board, CONFIG.model, &mut NoSerial);
     defmt::info!(
         "replaying {=u32} samples of the stored trace through the emulated MPU6050",
         TRACE_SAMPLES
@@ -123,44 +124,15 @@ pub fn run<const M: usize>(
     timer.start_periodic(trace::RATE_MILLIHERTZ);
     unmask();
 
-    let mut pipeline = Pipeline::<M>::sized(config);
     let mut startup = Startup::new(RATE, GYRO);
     let mut samples = 0u32;
     loop {
         while let Some(item) = consumer.dequeue() {
-            match item {
-                Item::Sample(s) => {
-                    samples = samples.wrapping_add(1);
-                    let stride = pipeline.process(&s);
-                    if let Some(e) = startup.update(&pipeline) {
-                        log.startup(e, &mut serial);
-                    }
-                    if let Some(stride) = stride {
-                        log.stride(&stride, &mut serial);
-                    }
-                }
-                Item::Gap(n) => {
-                    log.gap(n, &mut serial);
-                    if let Some(stride) = pipeline.gap(n) {
-                        log.stride(&stride, &mut serial);
-                    }
-                }
-            }
+            handle(item, pipeline, &mut startup, &mut log, &mut samples);
         }
         if TRACE_DONE.load(Ordering::Acquire) && !consumer.ready() {
             timer.stop();
-            for stride in pipeline.finish().iter().flatten() {
-                log.stride(stride, &mut serial);
-            }
-            let counters = irq::free(|cs| {
-                SAMPLER
-                    .borrow(cs)
-                    .borrow()
-                    .as_ref()
-                    .map_or(Counters::default(), |s| s.counters())
-            });
-            log.summary(samples, &counters, &mut serial);
-            debug::exit(EXIT_SUCCESS);
+            finish(pipeline, &mut log, samples);
         }
         // Sleep until the next interrupt. Interrupts are masked while checking the queue so
         // a sample that arrives between the check and `wfi` still wakes the core (WFI wakes
@@ -175,10 +147,64 @@ pub fn run<const M: usize>(
     }
 }
 
+/// One queue item through the pipeline. Not inlined: its temporaries (strides, features)
+/// then live on the stack only while it runs, not for the life of `run`'s frame, which a
+/// 16 KiB part cannot spare.
+#[inline(never)]
+fn handle<const M: usize>(
+    item: Item,
+    pipeline: &mut Pipeline<M>,
+    startup: &mut Startup,
+    log: &mut StrideLog,
+    samples: &mut u32,
+) {
+    let serial = &mut NoSerial;
+    match item {
+        Item::Sample(s) => {
+            *samples = samples.wrapping_add(1);
+            let stride = pipeline.process(&s);
+            if let Some(e) = startup.update(pipeline) {
+                log.startup(e, serial);
+            }
+            if let Some(stride) = stride {
+                log.stride(&stride, serial);
+            }
+        }
+        Item::Gap(n) => {
+            log.gap(n, serial);
+            if let Some(stride) = pipeline.gap(n) {
+                log.stride(&stride, serial);
+            }
+        }
+    }
+}
+
+/// The end of the trace: the strides still held, the summary, and QEMU's exit.
+#[inline(never)]
+fn finish<const M: usize>(pipeline: &mut Pipeline<M>, log: &mut StrideLog, samples: u32) -> ! {
+    let serial = &mut NoSerial;
+    for stride in pipeline.finish().iter().flatten() {
+        log.stride(stride, serial);
+    }
+    let counters = irq::free(|cs| {
+        SAMPLER
+            .borrow(cs)
+            .borrow()
+            .as_ref()
+            .map_or(Counters::default(), |s| s.counters())
+    });
+    log.summary(samples, &counters, serial);
+    debug::exit(EXIT_SUCCESS);
+    cortex_m::asm::udf()
+}
+
 /// The timer's interrupt, after the board acknowledged it: one data-ready pulse of the
 /// emulated sensor, or the end of the trace. Returns `false` when the timer should stop.
 pub fn on_data_ready() -> bool {
-    let pulse = PULSES.fetch_add(1, Ordering::Relaxed);
+    // Load and store, not fetch_add: ARMv6-M has no atomic read-modify-write, and this
+    // handler is the only writer.
+    let pulse = PULSES.load(Ordering::Relaxed);
+    PULSES.store(pulse.saturating_add(1), Ordering::Relaxed);
     if pulse >= TRACE_SAMPLES {
         TRACE_DONE.store(true, Ordering::Release);
         return false;

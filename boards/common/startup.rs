@@ -97,9 +97,9 @@ impl Startup {
                     let gyro_bias_mdps = pipeline
                         .gyro_bias()
                         .map(|c| (c as i64 * 10_000 / lsb_x10) as i32);
-                    let gravity_mg =
-                        (f.gravity() as i64 * 1000 / gaitclip::foot_frame::FOOT_LSB_PER_G as i64)
-                            as i32;
+                    let gravity_mg = (f.gravity() as i64 * 1000
+                        / gaitclip::foot_frame::FOOT_LSB_PER_G as i64)
+                        as i32;
                     let plausible = gyro_bias_mdps
                         .iter()
                         .all(|b| b.abs() <= GYRO_BIAS_LIMIT_MDPS)

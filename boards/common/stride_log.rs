@@ -140,10 +140,7 @@ impl StrideLog {
         );
         let _ = serial_line::comment(
             serial,
-            format_args!(
-                "gap samples={}: the stride in progress is dropped",
-                samples
-            ),
+            format_args!("gap samples={}: the stride in progress is dropped", samples),
         );
     }
 

@@ -34,7 +34,9 @@ use defmt_semihosting as _;
 use gaitclip::stride::MAX_MOVEMENT_SAMPLES;
 
 use cmsdk_timer::{CmsdkTimer, TIMER0_BASE, TIMER0_IRQ};
+use gaitclip::pipeline::Pipeline;
 use replay_app::{fail, SampleTimer};
+use static_cell::ConstStaticCell;
 
 /// The MPS2 core clock, 25 MHz.
 const CYCLES_PER_US: u32 = 25;
@@ -60,11 +62,18 @@ impl SampleTimer for CmsdkTimer {
     }
 }
 
+/// The pipeline, built at compile time into .data: no copy of it ever sits on the stack
+/// (moving 8–12 KiB through the stack is more than a 16 KiB part can spare), and the stack
+/// holds only what one sample's processing needs.
+static PIPELINE: ConstStaticCell<Pipeline<MAX_MOVEMENT_SAMPLES>> =
+    ConstStaticCell::new(Pipeline::sized(replay_app::CONFIG));
+
 #[entry]
 fn main() -> ! {
     // Note(unsafe): TIMER0 is driven only through this value, from here and its handler.
     let timer = unsafe { CmsdkTimer::new(TIMER0_BASE) };
-    replay_app::run::<MAX_MOVEMENT_SAMPLES>("mps2-an386", CYCLES_PER_US, &timer, || {
+    let pipeline = PIPELINE.take();
+    replay_app::run(pipeline, "mps2-an386", CYCLES_PER_US, &timer, || {
         // Note(unsafe): the handler only touches state behind `Mutex`es and atomics, so
         // unmasking cannot break a critical section.
         unsafe { NVIC::unmask(Irq(TIMER0_IRQ)) }

@@ -11,9 +11,11 @@ pub fn repo_root() -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR")).join("..")
 }
 
-/// Builds `bin` for `target` in release mode and returns the ELF path.
-pub fn build(bin: &str, target: &str) -> anyhow::Result<PathBuf> {
-    let root = repo_root();
+/// Builds `bin` for `target` in release mode from the package in `dir` (relative to the
+/// repository root: `.` for the top-level crate, `boards/microbit` for a board with its own
+/// workspace) and returns the ELF path.
+pub fn build_in(dir: &str, bin: &str, target: &str) -> anyhow::Result<PathBuf> {
+    let root = repo_root().join(dir);
     let status = Command::new(std::env::var("CARGO").unwrap_or_else(|_| "cargo".into()))
         .current_dir(&root)
         .env_remove("CARGO_BUILD_TARGET")
@@ -27,6 +29,11 @@ pub fn build(bin: &str, target: &str) -> anyhow::Result<PathBuf> {
         bail!("firmware build failed ({status})");
     }
     Ok(root.join("target").join(target).join("release").join(bin))
+}
+
+/// Builds `bin` of the top-level crate for `target`; see [`build_in`].
+pub fn build(bin: &str, target: &str) -> anyhow::Result<PathBuf> {
+    build_in(".", bin, target)
 }
 
 /// The integers of one `stride …` log line.

@@ -8,6 +8,8 @@ use anyhow::{bail, Context};
 
 /// QEMU machines gaitclip firmware runs on.
 pub const MACHINE_M4: &str = "mps2-an386";
+/// The Cortex-M0 machine: BBC micro:bit (nRF51822, 16 KiB RAM).
+pub const MACHINE_M0: &str = "microbit";
 
 /// How to run.
 #[derive(Clone, Debug)]

@@ -1,6 +1,7 @@
-//! Bit-exact end to end: the firmware on the emulated Cortex-M4 (QEMU mps2-an386), replaying
-//! the demo fixture from flash through the emulated sensor bus and the real driver, logs the
-//! same per-stride integers as the host replay of the same fixture.
+//! Bit-exact end to end: the firmware on the emulated Cortex-M4 (QEMU mps2-an386) and on the
+//! emulated Cortex-M0 (QEMU microbit, `thumbv6m-none-eabi`, no FPU), replaying the demo
+//! fixture from flash through the emulated sensor bus and the real driver, logs the same
+//! per-stride integers as the host replay of the same fixture.
 
 use gaitclip::rate::SampleRate;
 use gaitclip_host::firmware::{self, parse_stride_line, LoggedStride};
@@ -17,6 +18,20 @@ fn qemu_available() -> bool {
 
 #[test]
 fn qemu_m4_strides_equal_host_replay() {
+    strides_equal_host_replay(".", "mps2-an386", "thumbv7em-none-eabihf", qemu::MACHINE_M4);
+}
+
+#[test]
+fn qemu_m0_strides_equal_host_replay() {
+    strides_equal_host_replay(
+        "boards/microbit",
+        "microbit",
+        "thumbv6m-none-eabi",
+        qemu::MACHINE_M0,
+    );
+}
+
+fn strides_equal_host_replay(dir: &str, bin: &str, target: &str, machine: &str) {
     if !qemu_available() {
         if std::env::var("CI").is_ok_and(|v| v == "true") {
             panic!("qemu-system-arm is missing in CI (apt-get install qemu-system-arm)");
@@ -24,11 +39,11 @@ fn qemu_m4_strides_equal_host_replay() {
         eprintln!("SKIPPED: qemu-system-arm is not installed");
         return;
     }
-    let elf = firmware::build("mps2-an386", "thumbv7em-none-eabihf").expect("firmware builds");
+    let elf = firmware::build_in(dir, bin, target).expect("firmware builds");
     let out = qemu::run(
         &elf,
         &RunOptions {
-            machine: qemu::MACHINE_M4.into(),
+            machine: machine.into(),
             fast: true,
         },
         |_| {},
@@ -86,4 +101,9 @@ fn qemu_m4_strides_equal_host_replay() {
     );
     assert!(summary.contains("overruns=0"), "{summary}");
     assert!(summary.contains("bus_errors=0"), "{summary}");
+    assert!(summary.contains("lost_samples=0"), "{summary}");
+    assert!(
+        out.lines.iter().any(|l| l.starts_with("still: gyro_bias_mdps=")),
+        "no start-up calibration report"
+    );
 }
