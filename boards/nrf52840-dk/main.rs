@@ -1,0 +1,307 @@
+//! gaitclip on an nRF52840 (nRF52840-DK pin-out).
+//!
+//! | MPU6050 | nRF52840-DK | |
+//! |---|---|---|
+//! | SDA | P0.26 | TWIM0, 400 kHz (4.7 kΩ pull-ups on the breakout) |
+//! | SCL | P0.27 | |
+//! | INT | P0.03 | GPIOTE channel 0, rising edge |
+//! | VCC / GND | VDD / GND | 3.3 V |
+//! | serial out | P0.06 (TXD) | UARTE0, 115 200 8N1: the DK's USB virtual COM port |
+//!
+//! The sensor runs at 200 Hz with its FIFO on and pulses INT on every data-ready; the GPIOTE
+//! handler counts pulses and reads the FIFO every [`FIFO_BATCH`] of them in one burst
+//! ([`imu_sampler`]), pushing samples into the queue. TIMER1 ticks the sensor watchdog. The
+//! main loop runs the pipeline and sleeps (`wfi`). Strides go to defmt over RTT
+//! (`probe-rs run`) and, as CSV lines, to the UART.
+
+#![no_std]
+#![no_main]
+
+// The shared board glue: not every board uses every part of it.
+#[allow(dead_code)]
+#[path = "../common/imu_sampler.rs"]
+mod imu_sampler;
+#[allow(dead_code)]
+#[path = "../common/live_app.rs"]
+mod live_app;
+#[allow(dead_code)]
+#[path = "../common/serial_line.rs"]
+mod serial_line;
+#[allow(dead_code)]
+#[path = "../common/startup.rs"]
+mod startup;
+#[allow(dead_code)]
+#[path = "../common/stride_log.rs"]
+mod stride_log;
+
+use core::cell::RefCell;
+use core::sync::atomic::{AtomicU32, Ordering};
+
+use cortex_m::interrupt::{self as irq, Mutex};
+use cortex_m_rt::entry;
+use defmt_rtt as _;
+use embedded_hal::delay::DelayNs;
+use embedded_hal::i2c::{ErrorType, I2c, Operation, SevenBitAddress};
+use gaitclip::mpu6050::{self, Address, Mpu6050, OutputRate};
+use gaitclip::pipeline::{Config, Pipeline};
+use gaitclip::rate::SampleRate;
+use gaitclip::sample::{AccelRange, GyroRange};
+use gaitclip::stride::MAX_MOVEMENT_SAMPLES;
+use heapless::spsc::{Producer, Queue};
+use nrf52840_hal::{
+    self as hal,
+    gpio::{Floating, Input, Level, OpenDrainConfig, Pin},
+    gpiote::Gpiote,
+    pac::{self, interrupt, TIMER1, TWIM0},
+    timer::{Periodic, Timer},
+    twim::{self, Twim},
+    uarte::{self, Uarte},
+};
+use panic_probe as _;
+use static_cell::ConstStaticCell;
+
+use imu_sampler::{BusRecovery, ImuSampler, Item, ReadMode};
+use live_app::{Watchdog, WATCHDOG_TICK_MS};
+use startup::Startup;
+use stride_log::StrideLog;
+
+/// Output data rate of the sensor.
+const RATE_HZ: u16 = 200;
+/// Data-ready pulses per FIFO burst: 8 samples (40 ms) per I2C transaction at 200 Hz.
+const FIFO_BATCH: u8 = 8;
+/// Queue between the INT handler and the main loop: 0.64 s at 200 Hz.
+const QUEUE_LEN: usize = 128;
+const ACCEL: AccelRange = AccelRange::G16;
+const GYRO: GyroRange = GyroRange::Dps2000;
+const RATE: SampleRate = match SampleRate::from_hz(RATE_HZ as u32) {
+    Some(r) => r,
+    None => panic!("unsupported rate"),
+};
+const SENSOR: mpu6050::Config = mpu6050::Config {
+    rate: match OutputRate::from_hz(RATE_HZ) {
+        Some(r) => r,
+        None => panic!("unsupported output rate"),
+    },
+    accel: ACCEL,
+    gyro: GYRO,
+};
+
+/// TWIM0 that can give its pins back to clock a stuck bus free.
+struct RecoverableTwim {
+    twim: Option<Twim<TWIM0>>,
+}
+
+impl ErrorType for RecoverableTwim {
+    type Error = twim::Error;
+}
+
+impl I2c<SevenBitAddress> for RecoverableTwim {
+    fn transaction(
+        &mut self,
+        address: SevenBitAddress,
+        operations: &mut [Operation<'_>],
+    ) -> Result<(), Self::Error> {
+        match self.twim.as_mut() {
+            Some(t) => t.transaction(address, operations),
+            // Only between `free` and `new` in `recover_bus`, which nothing interrupts.
+            None => Err(twim::Error::Transmit),
+        }
+    }
+}
+
+impl BusRecovery for RecoverableTwim {
+    fn recover_bus(&mut self) -> bool {
+        let Some(twim) = self.twim.take() else {
+            return false;
+        };
+        let (periph, pins) = twim.free();
+        let sda = pins.sda;
+        let mut scl = pins
+            .scl
+            .into_open_drain_output(OpenDrainConfig::Standard0Disconnect1, Level::High);
+        // Nine clocks let a slave finish the byte it is sending and see a NACK; 5 µs half
+        // periods (100 kHz) at 64 MHz.
+        for _ in 0..9 {
+            let _ = embedded_hal::digital::OutputPin::set_low(&mut scl);
+            cortex_m::asm::delay(320);
+            let _ = embedded_hal::digital::OutputPin::set_high(&mut scl);
+            cortex_m::asm::delay(320);
+        }
+        let scl: Pin<Input<Floating>> = scl.into_floating_input();
+        self.twim = Some(Twim::new(
+            periph,
+            twim::Pins { scl, sda },
+            twim::Frequency::K400,
+        ));
+        true
+    }
+}
+
+/// Busy-wait delay (the sensor's 100 ms reset) at 64 MHz.
+struct SpinDelay;
+
+impl DelayNs for SpinDelay {
+    fn delay_ns(&mut self, ns: u32) {
+        cortex_m::asm::delay((ns / 1000).saturating_mul(64).max(1));
+    }
+}
+
+type Sampler = ImuSampler<RecoverableTwim, SpinDelay>;
+
+static SAMPLER: Mutex<RefCell<Option<Sampler>>> = Mutex::new(RefCell::new(None));
+static PRODUCER: Mutex<RefCell<Option<Producer<'static, Item>>>> = Mutex::new(RefCell::new(None));
+static GPIOTE: Mutex<RefCell<Option<Gpiote>>> = Mutex::new(RefCell::new(None));
+/// TIMER1, ticking the watchdog.
+type WatchdogTimer = Timer<TIMER1, Periodic>;
+static WATCHDOG: Mutex<RefCell<Option<(WatchdogTimer, Watchdog)>>> =
+    Mutex::new(RefCell::new(None));
+/// Data-ready interrupts so far (written by the GPIOTE handler only).
+static PULSES: AtomicU32 = AtomicU32::new(0);
+static QUEUE: ConstStaticCell<Queue<Item, QUEUE_LEN>> = ConstStaticCell::new(Queue::new());
+static PIPELINE: ConstStaticCell<Pipeline<MAX_MOVEMENT_SAMPLES>> =
+    ConstStaticCell::new(Pipeline::sized(Config::new(RATE, ACCEL, GYRO)));
+
+#[entry]
+fn main() -> ! {
+    let Some(p) = pac::Peripherals::take() else {
+        panic!("peripherals taken twice");
+    };
+    let _clocks = hal::clocks::Clocks::new(p.CLOCK).enable_ext_hfosc();
+    let port0 = hal::gpio::p0::Parts::new(p.P0);
+
+    let mut serial = Uarte::new(
+        p.UARTE0,
+        uarte::Pins {
+            txd: port0.p0_06.into_push_pull_output(Level::High).degrade(),
+            rxd: port0.p0_08.into_floating_input().degrade(),
+            cts: None,
+            rts: None,
+        },
+        uarte::Parity::EXCLUDED,
+        uarte::Baudrate::BAUD115200,
+    );
+    let mut log = StrideLog::new(RATE);
+    log.banner(
+        "nrf52840-dk",
+        gaitclip::pipeline::DEFAULT_MODEL,
+        &mut serial,
+    );
+
+    let bus = RecoverableTwim {
+        twim: Some(Twim::new(
+            p.TWIM0,
+            twim::Pins {
+                scl: port0.p0_27.into_floating_input().degrade(),
+                sda: port0.p0_26.into_floating_input().degrade(),
+            },
+            twim::Frequency::K400,
+        )),
+    };
+    let mut imu = Mpu6050::new(bus, Address::Ad0Low);
+    let mut delay = SpinDelay;
+    // A sensor that does not answer yet (still powering up, loose wire) is retried once a
+    // second, and said so, rather than given up on.
+    let sampler = loop {
+        match Sampler::start(imu, delay, SENSOR, ReadMode::Fifo { batch: FIFO_BATCH }) {
+            Ok(s) => break s,
+            Err((i, d, e)) => {
+                defmt::error!(
+                    "MPU6050 not ready ({}): check the wiring; retrying",
+                    defmt::Debug2Format(&e)
+                );
+                let _ = serial_line::comment(
+                    &mut serial,
+                    format_args!("MPU6050 not ready: check the wiring; retrying"),
+                );
+                (imu, delay) = (i, d);
+                delay.delay_ms(1000);
+            }
+        }
+    };
+
+    let (producer, mut consumer) = QUEUE.take().split();
+    let int_pin = port0.p0_03.into_floating_input().degrade();
+    let gpiote = Gpiote::new(p.GPIOTE);
+    gpiote
+        .channel0()
+        .input_pin(&int_pin)
+        .lo_to_hi()
+        .enable_interrupt();
+    let mut timer = Timer::periodic(p.TIMER1);
+    timer.enable_interrupt();
+    timer.start(WATCHDOG_TICK_MS * 1000); // 1 MHz timer clock
+    irq::free(|cs| {
+        SAMPLER.borrow(cs).replace(Some(sampler));
+        PRODUCER.borrow(cs).replace(Some(producer));
+        GPIOTE.borrow(cs).replace(Some(gpiote));
+        WATCHDOG.borrow(cs).replace(Some((timer, Watchdog::new())));
+    });
+    // Note(unsafe): both handlers only touch state behind `Mutex`es and atomics, so
+    // unmasking cannot break a critical section.
+    unsafe {
+        pac::NVIC::unmask(pac::Interrupt::GPIOTE);
+        pac::NVIC::unmask(pac::Interrupt::TIMER1);
+    }
+
+    let mut startup = Startup::new(RATE, GYRO);
+    live_app::main_loop(
+        PIPELINE.take(),
+        &mut consumer,
+        &mut log,
+        &mut serial,
+        &mut startup,
+        || {
+            irq::free(|cs| {
+                SAMPLER
+                    .borrow(cs)
+                    .borrow()
+                    .as_ref()
+                    .map(|s| s.counters())
+                    .unwrap_or_default()
+            })
+        },
+        RATE.samples_in_ms(live_app::STATUS_EVERY_MS),
+    )
+}
+
+/// Pushes into the queue; `false` when it is full.
+fn push_with<'a>(producer: &'a mut Producer<'static, Item>) -> impl FnMut(Item) -> bool + 'a {
+    move |item| producer.enqueue(item).is_ok()
+}
+
+#[interrupt]
+fn GPIOTE() {
+    PULSES.store(
+        PULSES.load(Ordering::Relaxed).wrapping_add(1),
+        Ordering::Relaxed,
+    );
+    irq::free(|cs| {
+        if let Some(g) = GPIOTE.borrow(cs).borrow().as_ref() {
+            g.channel0().reset_events();
+        }
+        let mut sampler = SAMPLER.borrow(cs).borrow_mut();
+        let mut producer = PRODUCER.borrow(cs).borrow_mut();
+        if let (Some(s), Some(p)) = (sampler.as_mut(), producer.as_mut()) {
+            s.on_data_ready(&mut push_with(p));
+        }
+    });
+}
+
+#[interrupt]
+fn TIMER1() {
+    irq::free(|cs| {
+        let mut wd = WATCHDOG.borrow(cs).borrow_mut();
+        let Some((timer, watchdog)) = wd.as_mut() else {
+            return;
+        };
+        timer.reset_event();
+        let per_tick = RATE.samples_in_ms(WATCHDOG_TICK_MS);
+        if let Some(lost) = watchdog.tick(PULSES.load(Ordering::Relaxed), per_tick) {
+            let mut sampler = SAMPLER.borrow(cs).borrow_mut();
+            let mut producer = PRODUCER.borrow(cs).borrow_mut();
+            if let (Some(s), Some(p)) = (sampler.as_mut(), producer.as_mut()) {
+                s.on_silence(lost, &mut push_with(p));
+            }
+        }
+    });
+}
