@@ -1,15 +1,18 @@
 #!/usr/bin/env bash
-# Runs every check of gaitclip, as CI does: formatting and clippy (-D warnings) in both
-# workspaces, firmware builds for both Cortex-M targets, and the host test suite (driver
-# transactions, fixed point vs f64, fixtures, MCAP/CSV readers, real datasets when
-# ../shared/datasets is present, and the bit-exact QEMU run of the firmware).
-# Installs what a fresh Debian machine lacks: qemu-system-arm (apt). rustup installs the
-# toolchain, targets and components named in rust-toolchain.toml by itself.
+# Runs every check of gaitclip, as CI does: formatting and clippy (-D warnings) in every
+# workspace, firmware builds for both Cortex-M targets and every board (nRF52840-DK,
+# Raspberry Pi Pico, QEMU micro:bit), and the host test suite (driver transactions, fixed
+# point vs f64, fixtures, MCAP/CSV readers, real datasets when ../shared/datasets is
+# present, and the bit-exact QEMU runs of the M4 and M0 firmware).
+# Installs what a fresh Debian machine lacks: qemu-system-arm (apt) and flip-link (cargo).
+# rustup installs the toolchain, targets and components named in rust-toolchain.toml.
 set -euo pipefail
 root=$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)
 cd "$root"
 
 bash "$root/boards/install-qemu"
+# The boards link through flip-link (stack-overflow protection); cargo installs it.
+command -v flip-link >/dev/null 2>&1 || cargo install --locked flip-link
 
 echo "== firmware crate: rustfmt, clippy, builds (thumbv7em-none-eabihf, thumbv6m-none-eabi)"
 cargo fmt --check
@@ -17,6 +20,11 @@ cargo clippy --release -- -D warnings
 cargo clippy --release --lib --target thumbv6m-none-eabi -- -D warnings
 cargo build --release
 cargo build --release --lib --target thumbv6m-none-eabi
+
+echo "== boards: rustfmt, clippy, release builds (nrf52840-dk, rp-pico, microbit)"
+for board in nrf52840-dk rp-pico microbit; do
+  (cd "$root/boards/$board" && cargo fmt --check && cargo clippy --release -- -D warnings && cargo build --release)
+done
 
 echo "== tests-host: rustfmt, clippy, tests"
 cd "$root/tests-host"

@@ -32,10 +32,10 @@ use cortex_m::peripheral::NVIC;
 use cortex_m_rt::{entry, exception, ExceptionFrame};
 use defmt_semihosting as _;
 
-use nrf51_timer::{Nrf51Timer, TIMER0_BASE, TIMER0_IRQ};
 use gaitclip::pipeline::Pipeline;
-use static_cell::ConstStaticCell;
+use nrf51_timer::{Nrf51Timer, TIMER0_BASE, TIMER0_IRQ};
 use replay_app::{fail, SampleTimer};
+use static_cell::ConstStaticCell;
 
 /// The nRF51 core clock, 16 MHz.
 const CYCLES_PER_US: u32 = 16;

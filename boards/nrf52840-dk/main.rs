@@ -153,8 +153,7 @@ static PRODUCER: Mutex<RefCell<Option<Producer<'static, Item>>>> = Mutex::new(Re
 static GPIOTE: Mutex<RefCell<Option<Gpiote>>> = Mutex::new(RefCell::new(None));
 /// TIMER1, ticking the watchdog.
 type WatchdogTimer = Timer<TIMER1, Periodic>;
-static WATCHDOG: Mutex<RefCell<Option<(WatchdogTimer, Watchdog)>>> =
-    Mutex::new(RefCell::new(None));
+static WATCHDOG: Mutex<RefCell<Option<(WatchdogTimer, Watchdog)>>> = Mutex::new(RefCell::new(None));
 /// Data-ready interrupts so far (written by the GPIOTE handler only).
 static PULSES: AtomicU32 = AtomicU32::new(0);
 static QUEUE: ConstStaticCell<Queue<Item, QUEUE_LEN>> = ConstStaticCell::new(Queue::new());

@@ -1,1 +1,334 @@
-fn main(){}
+//! gaitclip on a Raspberry Pi Pico (RP2040: Cortex-M0+, no FPU).
+//!
+//! | MPU6050 | Pico | |
+//! |---|---|---|
+//! | SDA | GP4 (pin 6) | I2C0, 400 kHz, internal pull-ups (plus the breakout's) |
+//! | SCL | GP5 (pin 7) | |
+//! | INT | GP6 (pin 9) | rising edge, IO_IRQ_BANK0 |
+//! | VCC / GND | 3V3(OUT) (pin 36) / GND (pin 38) | |
+//! | serial out | GP0 (pin 1, UART0 TX) | 115 200 8N1, to a USB-serial adapter's RX |
+//!
+//! Same firmware as the nRF52840 board: FIFO bursts on data-ready pulses, the shared sampler
+//! with retries, bus recovery and re-initialisation, the TIMER alarm as the sensor
+//! watchdog, the pipeline in the main loop with `wfi`, strides on defmt-RTT and the UART.
+
+#![no_std]
+#![no_main]
+
+// The shared board glue: not every board uses every part of it.
+#[allow(dead_code)]
+#[path = "../common/imu_sampler.rs"]
+mod imu_sampler;
+#[allow(dead_code)]
+#[path = "../common/live_app.rs"]
+mod live_app;
+#[allow(dead_code)]
+#[path = "../common/serial_line.rs"]
+mod serial_line;
+#[allow(dead_code)]
+#[path = "../common/startup.rs"]
+mod startup;
+#[allow(dead_code)]
+#[path = "../common/stride_log.rs"]
+mod stride_log;
+
+use core::cell::RefCell;
+use core::sync::atomic::{AtomicU32, Ordering};
+
+use cortex_m::interrupt::{self as irq, Mutex};
+use defmt_rtt as _;
+use embedded_hal::delay::DelayNs;
+use embedded_hal::digital::OutputPin;
+use embedded_hal::i2c::{ErrorType, I2c, Operation, SevenBitAddress};
+use fugit::{HertzU32, RateExtU32};
+use gaitclip::mpu6050::{self, Address, Mpu6050, OutputRate};
+use gaitclip::pipeline::{Config, Pipeline};
+use gaitclip::rate::SampleRate;
+use gaitclip::sample::{AccelRange, GyroRange};
+use gaitclip::stride::MAX_MOVEMENT_SAMPLES;
+use heapless::spsc::{Producer, Queue};
+use panic_probe as _;
+use rp2040_hal::{
+    self as hal,
+    clocks::{init_clocks_and_plls, Clock},
+    gpio::{
+        bank0::{Gpio4, Gpio5, Gpio6},
+        FunctionI2C, FunctionSioInput, FunctionUart, Interrupt as PinInterrupt, Pin, Pins,
+        PullDown, PullUp,
+    },
+    pac::{self, interrupt},
+    timer::{Alarm, Alarm0},
+    uart::{DataBits, StopBits, UartConfig, UartPeripheral},
+    Sio, Timer, Watchdog,
+};
+use static_cell::ConstStaticCell;
+
+use imu_sampler::{BusRecovery, ImuSampler, Item, ReadMode};
+use live_app::{Watchdog as SensorWatchdog, WATCHDOG_TICK_MS};
+use startup::Startup;
+use stride_log::StrideLog;
+
+/// The second-stage bootloader for the Pico's W25Q080 flash.
+#[link_section = ".boot2"]
+#[used]
+pub static BOOT2: [u8; 256] = rp2040_boot2::BOOT_LOADER_W25Q080;
+
+/// The Pico's crystal.
+const XOSC_HZ: u32 = 12_000_000;
+/// Output data rate of the sensor.
+const RATE_HZ: u16 = 200;
+/// Data-ready pulses per FIFO burst: 8 samples (40 ms) per I2C transaction at 200 Hz.
+const FIFO_BATCH: u8 = 8;
+/// Queue between the INT handler and the main loop: 0.64 s at 200 Hz.
+const QUEUE_LEN: usize = 128;
+const ACCEL: AccelRange = AccelRange::G16;
+const GYRO: GyroRange = GyroRange::Dps2000;
+const RATE: SampleRate = match SampleRate::from_hz(RATE_HZ as u32) {
+    Some(r) => r,
+    None => panic!("unsupported rate"),
+};
+const SENSOR: mpu6050::Config = mpu6050::Config {
+    rate: match OutputRate::from_hz(RATE_HZ) {
+        Some(r) => r,
+        None => panic!("unsupported output rate"),
+    },
+    accel: ACCEL,
+    gyro: GYRO,
+};
+
+type Sda = Pin<Gpio4, FunctionI2C, PullUp>;
+type Scl = Pin<Gpio5, FunctionI2C, PullUp>;
+type Bus = hal::I2C<pac::I2C0, (Sda, Scl)>;
+type IntPin = Pin<Gpio6, FunctionSioInput, PullDown>;
+
+/// I2C0 that can give its pins back to clock a stuck bus free.
+struct RecoverableI2c {
+    i2c: Option<Bus>,
+    resets: pac::RESETS,
+    system_clock: HertzU32,
+}
+
+impl ErrorType for RecoverableI2c {
+    type Error = hal::i2c::Error;
+}
+
+impl I2c<SevenBitAddress> for RecoverableI2c {
+    fn transaction(
+        &mut self,
+        address: SevenBitAddress,
+        operations: &mut [Operation<'_>],
+    ) -> Result<(), Self::Error> {
+        match self.i2c.as_mut() {
+            Some(i2c) => i2c.transaction(address, operations),
+            // Only between `free` and `i2c0` in `recover_bus`, which nothing interrupts.
+            None => Err(hal::i2c::Error::Abort(0)),
+        }
+    }
+}
+
+impl BusRecovery for RecoverableI2c {
+    fn recover_bus(&mut self) -> bool {
+        let Some(i2c) = self.i2c.take() else {
+            return false;
+        };
+        let (block, (sda, scl)) = i2c.free(&mut self.resets);
+        let mut scl = scl.into_push_pull_output();
+        // Nine clocks let a slave finish the byte it is sending and see a NACK; 5 µs half
+        // periods (100 kHz) at 125 MHz.
+        for _ in 0..9 {
+            let _ = scl.set_low();
+            cortex_m::asm::delay(625);
+            let _ = scl.set_high();
+            cortex_m::asm::delay(625);
+        }
+        let scl: Scl = scl.into_function();
+        self.i2c = Some(hal::I2C::i2c0(
+            block,
+            sda,
+            scl,
+            400.kHz(),
+            &mut self.resets,
+            self.system_clock,
+        ));
+        true
+    }
+}
+
+/// Busy-wait delay (the sensor's 100 ms reset) at 125 MHz.
+struct SpinDelay;
+
+impl DelayNs for SpinDelay {
+    fn delay_ns(&mut self, ns: u32) {
+        cortex_m::asm::delay((ns / 1000).saturating_mul(125).max(1));
+    }
+}
+
+type Sampler = ImuSampler<RecoverableI2c, SpinDelay>;
+
+static SAMPLER: Mutex<RefCell<Option<Sampler>>> = Mutex::new(RefCell::new(None));
+static PRODUCER: Mutex<RefCell<Option<Producer<'static, Item>>>> = Mutex::new(RefCell::new(None));
+static INT_PIN: Mutex<RefCell<Option<IntPin>>> = Mutex::new(RefCell::new(None));
+static WATCHDOG: Mutex<RefCell<Option<(Alarm0, SensorWatchdog)>>> = Mutex::new(RefCell::new(None));
+/// Data-ready interrupts so far (written by the GPIO handler only: ARMv6-M has no atomic
+/// read-modify-write, so it is a load and a store).
+static PULSES: AtomicU32 = AtomicU32::new(0);
+static QUEUE: ConstStaticCell<Queue<Item, QUEUE_LEN>> = ConstStaticCell::new(Queue::new());
+static PIPELINE: ConstStaticCell<Pipeline<MAX_MOVEMENT_SAMPLES>> =
+    ConstStaticCell::new(Pipeline::sized(Config::new(RATE, ACCEL, GYRO)));
+
+#[hal::entry]
+fn main() -> ! {
+    let Some(mut pac) = pac::Peripherals::take() else {
+        panic!("peripherals taken twice");
+    };
+    let mut watchdog = Watchdog::new(pac.WATCHDOG);
+    let Ok(clocks) = init_clocks_and_plls(
+        XOSC_HZ,
+        pac.XOSC,
+        pac.CLOCKS,
+        pac.PLL_SYS,
+        pac.PLL_USB,
+        &mut pac.RESETS,
+        &mut watchdog,
+    ) else {
+        panic!("clocks did not start");
+    };
+    let sio = Sio::new(pac.SIO);
+    let pins = Pins::new(
+        pac.IO_BANK0,
+        pac.PADS_BANK0,
+        sio.gpio_bank0,
+        &mut pac.RESETS,
+    );
+
+    let uart_pins = (
+        pins.gpio0.into_function::<FunctionUart>(),
+        pins.gpio1.into_function::<FunctionUart>(),
+    );
+    let Ok(mut serial) = UartPeripheral::new(pac.UART0, uart_pins, &mut pac.RESETS).enable(
+        UartConfig::new(115_200.Hz(), DataBits::Eight, None, StopBits::One),
+        clocks.peripheral_clock.freq(),
+    ) else {
+        panic!("UART0 did not start");
+    };
+    let mut log = StrideLog::new(RATE);
+    log.banner("rp-pico", gaitclip::pipeline::DEFAULT_MODEL, &mut serial);
+
+    let sda: Sda = pins.gpio4.reconfigure();
+    let scl: Scl = pins.gpio5.reconfigure();
+    let system_clock = clocks.system_clock.freq();
+    let mut timer = Timer::new(pac.TIMER, &mut pac.RESETS, &clocks);
+    let i2c = hal::I2C::i2c0(pac.I2C0, sda, scl, 400.kHz(), &mut pac.RESETS, system_clock);
+    let bus = RecoverableI2c {
+        i2c: Some(i2c),
+        resets: pac.RESETS,
+        system_clock,
+    };
+    let mut imu = Mpu6050::new(bus, Address::Ad0Low);
+    let mut delay = SpinDelay;
+    // A sensor that does not answer yet (still powering up, loose wire) is retried once a
+    // second, and said so, rather than given up on.
+    let sampler = loop {
+        match Sampler::start(imu, delay, SENSOR, ReadMode::Fifo { batch: FIFO_BATCH }) {
+            Ok(s) => break s,
+            Err((i, d, e)) => {
+                defmt::error!(
+                    "MPU6050 not ready ({}): check the wiring; retrying",
+                    defmt::Debug2Format(&e)
+                );
+                let _ = serial_line::comment(
+                    &mut serial,
+                    format_args!("MPU6050 not ready: check the wiring; retrying"),
+                );
+                (imu, delay) = (i, d);
+                delay.delay_ms(1000);
+            }
+        }
+    };
+
+    let (producer, mut consumer) = QUEUE.take().split();
+    let int_pin: IntPin = pins.gpio6.into_pull_down_input();
+    int_pin.set_interrupt_enabled(PinInterrupt::EdgeHigh, true);
+    let Some(mut alarm) = timer.alarm_0() else {
+        panic!("alarm 0 taken");
+    };
+    let _ = alarm.schedule(fugit::MicrosDurationU32::millis(WATCHDOG_TICK_MS));
+    alarm.enable_interrupt();
+    irq::free(|cs| {
+        SAMPLER.borrow(cs).replace(Some(sampler));
+        PRODUCER.borrow(cs).replace(Some(producer));
+        INT_PIN.borrow(cs).replace(Some(int_pin));
+        WATCHDOG
+            .borrow(cs)
+            .replace(Some((alarm, SensorWatchdog::new())));
+    });
+    // Note(unsafe): both handlers only touch state behind `Mutex`es and atomics, so
+    // unmasking cannot break a critical section.
+    unsafe {
+        pac::NVIC::unmask(pac::Interrupt::IO_IRQ_BANK0);
+        pac::NVIC::unmask(pac::Interrupt::TIMER_IRQ_0);
+    }
+
+    let mut startup = Startup::new(RATE, GYRO);
+    live_app::main_loop(
+        PIPELINE.take(),
+        &mut consumer,
+        &mut log,
+        &mut serial,
+        &mut startup,
+        || {
+            irq::free(|cs| {
+                SAMPLER
+                    .borrow(cs)
+                    .borrow()
+                    .as_ref()
+                    .map(|s| s.counters())
+                    .unwrap_or_default()
+            })
+        },
+        RATE.samples_in_ms(live_app::STATUS_EVERY_MS),
+    )
+}
+
+/// Pushes into the queue; `false` when it is full.
+fn push_with<'a>(producer: &'a mut Producer<'static, Item>) -> impl FnMut(Item) -> bool + 'a {
+    move |item| producer.enqueue(item).is_ok()
+}
+
+#[interrupt]
+fn IO_IRQ_BANK0() {
+    PULSES.store(
+        PULSES.load(Ordering::Relaxed).wrapping_add(1),
+        Ordering::Relaxed,
+    );
+    irq::free(|cs| {
+        if let Some(pin) = INT_PIN.borrow(cs).borrow_mut().as_mut() {
+            pin.clear_interrupt(PinInterrupt::EdgeHigh);
+        }
+        let mut sampler = SAMPLER.borrow(cs).borrow_mut();
+        let mut producer = PRODUCER.borrow(cs).borrow_mut();
+        if let (Some(s), Some(p)) = (sampler.as_mut(), producer.as_mut()) {
+            s.on_data_ready(&mut push_with(p));
+        }
+    });
+}
+
+#[interrupt]
+fn TIMER_IRQ_0() {
+    irq::free(|cs| {
+        let mut wd = WATCHDOG.borrow(cs).borrow_mut();
+        let Some((alarm, watchdog)) = wd.as_mut() else {
+            return;
+        };
+        alarm.clear_interrupt();
+        let _ = alarm.schedule(fugit::MicrosDurationU32::millis(WATCHDOG_TICK_MS));
+        let per_tick = RATE.samples_in_ms(WATCHDOG_TICK_MS);
+        if let Some(lost) = watchdog.tick(PULSES.load(Ordering::Relaxed), per_tick) {
+            let mut sampler = SAMPLER.borrow(cs).borrow_mut();
+            let mut producer = PRODUCER.borrow(cs).borrow_mut();
+            if let (Some(s), Some(p)) = (sampler.as_mut(), producer.as_mut()) {
+                s.on_silence(lost, &mut push_with(p));
+            }
+        }
+    });
+}
