@@ -30,7 +30,7 @@ use crate::imu_sampler::Counters;
 
 /// Longest line this module writes, with its `\r\n` (the status line with every counter
 /// at its maximum): the size of a board's line buffer.
-pub const MAX_LINE: usize = 192;
+pub const MAX_LINE: usize = 256;
 
 /// The CSV header line.
 pub const HEADER: &str = "index,t_ms,length_mm,duration_ms,stance_ms,push_off_ms,swing_ms,heel_strike_ms,climb_mm,flags,valid";

@@ -784,8 +784,20 @@ fn svr_source(out: &mut String, gate: &str, name: &str, s: &SvrQ) -> String {
         .collect();
     array(out, gate, &format!("{name}_FEATURES"), "u8", &features);
     array(out, gate, &format!("{name}_MEAN_Q16"), "i64", &s.mean_q16);
-    array(out, gate, &format!("{name}_INV_STD_Q32"), "i64", &s.inv_std_q32);
-    array(out, gate, &format!("{name}_SUPPORT_Q16"), "i32", &s.support_q16);
+    array(
+        out,
+        gate,
+        &format!("{name}_INV_STD_Q32"),
+        "i64",
+        &s.inv_std_q32,
+    );
+    array(
+        out,
+        gate,
+        &format!("{name}_SUPPORT_Q16"),
+        "i32",
+        &s.support_q16,
+    );
     array(out, gate, &format!("{name}_ALPHA_NM"), "i64", &s.alpha_nm);
     format!(
         "Svr {{\n        features: &{name}_FEATURES,\n        mean_q16: &{name}_MEAN_Q16,\n        inv_std_q32: &{name}_INV_STD_Q32,\n        gamma_q32: {},\n        support_q16: &{name}_SUPPORT_Q16,\n        alpha_nm: &{name}_ALPHA_NM,\n        rho_nm: {},\n    }}",
@@ -819,7 +831,14 @@ pub fn rust_source(t: &Training) -> String {
             .members
             .iter()
             .enumerate()
-            .map(|(k, m)| svr_source(&mut body, boost_gate, &format!("BOOST_{n}_{k}"), &m.quantize()))
+            .map(|(k, m)| {
+                svr_source(
+                    &mut body,
+                    boost_gate,
+                    &format!("BOOST_{n}_{k}"),
+                    &m.quantize(),
+                )
+            })
             .collect();
         let _ = writeln!(
             body,

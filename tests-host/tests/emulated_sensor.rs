@@ -1,6 +1,9 @@
 //! The emulated MPU6050 of the QEMU board, driven by the real driver on the host: it serves
 //! the fixture sample by sample and ends with the trace.
 
+#[path = "../../boards/common/imu_sampler.rs"]
+#[allow(dead_code)]
+mod imu_sampler;
 #[path = "../../boards/common/replay_mpu6050.rs"]
 #[allow(dead_code)]
 mod replay_mpu6050;

@@ -103,7 +103,9 @@ fn strides_equal_host_replay(dir: &str, bin: &str, target: &str, machine: &str) 
     assert!(summary.contains("bus_errors=0"), "{summary}");
     assert!(summary.contains("lost_samples=0"), "{summary}");
     assert!(
-        out.lines.iter().any(|l| l.starts_with("still: gyro_bias_mdps=")),
+        out.lines
+            .iter()
+            .any(|l| l.starts_with("still: gyro_bias_mdps=")),
         "no start-up calibration report"
     );
 }
