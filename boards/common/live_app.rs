@@ -6,13 +6,19 @@
 //! `wfi`. A periodic timer drives the [`Watchdog`], which notices a sensor that stopped
 //! pulsing (reset, brown-out, loose wire) and has the sampler set it up again.
 
+use core::cell::RefCell;
 use core::fmt::Write;
+use core::sync::atomic::{AtomicU32, Ordering};
 
-use cortex_m::interrupt as irq;
+use cortex_m::interrupt::{self as irq, Mutex};
+use embedded_hal::delay::DelayNs;
+use embedded_hal::i2c::I2c;
+use gaitclip::mpu6050::{self, Mpu6050};
 use gaitclip::pipeline::Pipeline;
-use heapless::spsc::Consumer;
+use heapless::spsc::{Consumer, Producer};
 
-use crate::imu_sampler::{Counters, Item};
+use crate::imu_sampler::{BusRecovery, Counters, ImuSampler, Item, ReadMode};
+use crate::serial_line;
 use crate::startup::Startup;
 use crate::stride_log::StrideLog;
 
@@ -22,6 +28,113 @@ pub const STATUS_EVERY_MS: u32 = 60_000;
 pub const WATCHDOG_TICK_MS: u32 = 100;
 /// Watchdog ticks without a data-ready pulse after which the sensor is declared silent.
 pub const SILENT_TICKS: u32 = 3;
+
+/// What the interrupts share with the main loop: the sampler, the queue's producer and the
+/// count of data-ready pulses. A board keeps one in a static.
+pub struct SampleLink<I, D> {
+    sampler: Mutex<RefCell<Option<ImuSampler<I, D>>>>,
+    producer: Mutex<RefCell<Option<Producer<'static, Item>>>>,
+    /// Data-ready interrupts so far. Written by the INT handler only, with a load and a
+    /// store: ARMv6-M has no atomic read-modify-write.
+    pulses: AtomicU32,
+}
+
+impl<I, D> SampleLink<I, D>
+where
+    I: I2c + BusRecovery,
+    D: DelayNs,
+{
+    /// An empty link, for a static.
+    pub const fn new() -> Self {
+        SampleLink {
+            sampler: Mutex::new(RefCell::new(None)),
+            producer: Mutex::new(RefCell::new(None)),
+            pulses: AtomicU32::new(0),
+        }
+    }
+
+    /// Hands the started sampler and the queue's producer to the interrupts.
+    pub fn install(&self, sampler: ImuSampler<I, D>, producer: Producer<'static, Item>) {
+        irq::free(|cs| {
+            self.sampler.borrow(cs).replace(Some(sampler));
+            self.producer.borrow(cs).replace(Some(producer));
+        });
+    }
+
+    /// Data-ready pulses so far.
+    pub fn pulses(&self) -> u32 {
+        self.pulses.load(Ordering::Relaxed)
+    }
+
+    /// The fault counters.
+    pub fn counters(&self) -> Counters {
+        irq::free(|cs| {
+            self.sampler
+                .borrow(cs)
+                .borrow()
+                .as_ref()
+                .map(|s| s.counters())
+                .unwrap_or_default()
+        })
+    }
+
+    /// The body of the INT pin's interrupt.
+    pub fn on_data_ready(&self) {
+        self.pulses
+            .store(self.pulses().wrapping_add(1), Ordering::Relaxed);
+        self.with(|s, mut push| s.on_data_ready(&mut push));
+    }
+
+    /// The body of the watchdog timer's interrupt: `periods_per_tick` sample periods
+    /// elapse per tick.
+    pub fn on_watchdog_tick(&self, watchdog: &mut Watchdog, periods_per_tick: u32) {
+        if let Some(lost) = watchdog.tick(self.pulses(), periods_per_tick) {
+            self.with(|s, mut push| s.on_silence(lost, &mut push));
+        }
+    }
+
+    fn with(&self, f: impl FnOnce(&mut ImuSampler<I, D>, &mut dyn FnMut(Item) -> bool)) {
+        irq::free(|cs| {
+            let mut sampler = self.sampler.borrow(cs).borrow_mut();
+            let mut producer = self.producer.borrow(cs).borrow_mut();
+            if let (Some(s), Some(p)) = (sampler.as_mut(), producer.as_mut()) {
+                f(s, &mut |item| p.enqueue(item).is_ok());
+            }
+        });
+    }
+}
+
+/// Starts the sensor, retrying once a second (and saying so on both outputs) while it does
+/// not answer: still powering up, or a loose wire.
+pub fn start_sensor<I, D>(
+    mut imu: Mpu6050<I>,
+    mut delay: D,
+    config: mpu6050::Config,
+    mode: ReadMode,
+    serial: &mut impl Write,
+) -> ImuSampler<I, D>
+where
+    I: I2c + BusRecovery,
+    D: DelayNs,
+{
+    loop {
+        match ImuSampler::start(imu, delay, config, mode) {
+            Ok(s) => return s,
+            Err((i, d, e)) => {
+                defmt::error!(
+                    "MPU6050 not ready ({}): check the wiring; retrying",
+                    defmt::Debug2Format(&e)
+                );
+                let _ = serial_line::comment(
+                    serial,
+                    format_args!("MPU6050 not ready: check the wiring; retrying"),
+                );
+                (imu, delay) = (i, d);
+                delay.delay_ms(1000);
+            }
+        }
+    }
+}
 
 /// Finds a sensor that stopped pulsing.
 pub struct Watchdog {

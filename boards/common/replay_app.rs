@@ -8,19 +8,19 @@
 //! empty. When the trace ends it logs a summary and exits QEMU through semihosting with
 //! status 0; a panic or HardFault exits with status 1 ([`fail`]).
 
-use core::cell::RefCell;
-use core::sync::atomic::{AtomicBool, AtomicU32, Ordering};
+use core::sync::atomic::{AtomicBool, Ordering};
 
-use cortex_m::interrupt::{self as irq, Mutex};
+use cortex_m::interrupt as irq;
 use cortex_m_semihosting::debug::{self, EXIT_FAILURE, EXIT_SUCCESS};
 use embedded_hal::delay::DelayNs;
 use gaitclip::mpu6050::{self, Address, Mpu6050};
 use gaitclip::pipeline::{Config, Pipeline};
 use gaitclip::rate::SampleRate;
 use gaitclip::sample::{AccelRange, GyroRange, SAMPLE_BYTES};
-use heapless::spsc::{Producer, Queue};
+use heapless::spsc::Queue;
 
-use crate::imu_sampler::{Counters, ImuSampler, Item, ReadMode};
+use crate::imu_sampler::{ImuSampler, Item, ReadMode};
+use crate::live_app::SampleLink;
 use crate::replay_mpu6050::ReplayMpu6050;
 use crate::startup::Startup;
 use crate::stride_log::{NoSerial, StrideLog};
@@ -66,11 +66,8 @@ impl DelayNs for SpinDelay {
     }
 }
 
-type Sampler = ImuSampler<ReplayMpu6050, SpinDelay>;
-
-static PRODUCER: Mutex<RefCell<Option<Producer<'static, Item>>>> = Mutex::new(RefCell::new(None));
-static SAMPLER: Mutex<RefCell<Option<Sampler>>> = Mutex::new(RefCell::new(None));
-static PULSES: AtomicU32 = AtomicU32::new(0);
+/// Sampler, queue producer and pulse count, shared by the timer interrupt and the main loop.
+static LINK: SampleLink<ReplayMpu6050, SpinDelay> = SampleLink::new();
 static TRACE_DONE: AtomicBool = AtomicBool::new(false);
 
 /// The board's sample timer.
@@ -79,6 +76,20 @@ pub trait SampleTimer {
     fn start_periodic(&self, millihertz: u32);
     /// Stops them.
     fn stop(&self);
+    /// Acknowledges the interrupt.
+    fn clear_interrupt(&self);
+}
+
+/// An external interrupt number of the board, for the NVIC.
+#[derive(Clone, Copy)]
+pub struct Irq(pub u16);
+
+// Note(unsafe): the boards construct `Irq` only with their timer's interrupt number, which
+// is a valid external interrupt of the device (both have 32).
+unsafe impl cortex_m::interrupt::InterruptNumber for Irq {
+    fn number(self) -> u16 {
+        self.0
+    }
 }
 
 /// Runs the trace through `pipeline` (made from [`CONFIG`]; the board keeps it in a static,
@@ -94,7 +105,7 @@ pub fn run<const M: usize>(
         ReplayMpu6050::new(Address::Ad0Low.bits(), trace::REGISTERS),
         Address::Ad0Low,
     );
-    let sampler = match Sampler::start(
+    let sampler = match ImuSampler::start(
         imu,
         SpinDelay { cycles_per_us },
         SENSOR,
@@ -117,10 +128,7 @@ pub fn run<const M: usize>(
         fail();
     };
     let (producer, mut consumer) = queue.split();
-    irq::free(|cs| {
-        PRODUCER.borrow(cs).replace(Some(producer));
-        SAMPLER.borrow(cs).replace(Some(sampler));
-    });
+    LINK.install(sampler, producer);
     timer.start_periodic(trace::RATE_MILLIHERTZ);
     unmask();
 
@@ -186,37 +194,33 @@ fn finish<const M: usize>(pipeline: &mut Pipeline<M>, log: &mut StrideLog, sampl
     for stride in pipeline.finish().iter().flatten() {
         log.stride(stride, serial);
     }
-    let counters = irq::free(|cs| {
-        SAMPLER
-            .borrow(cs)
-            .borrow()
-            .as_ref()
-            .map_or(Counters::default(), |s| s.counters())
-    });
-    log.summary(samples, &counters, serial);
+    log.summary(samples, &LINK.counters(), serial);
     debug::exit(EXIT_SUCCESS);
     cortex_m::asm::udf()
 }
 
-/// The timer's interrupt, after the board acknowledged it: one data-ready pulse of the
-/// emulated sensor, or the end of the trace. Returns `false` when the timer should stop.
-pub fn on_data_ready() -> bool {
-    // Load and store, not fetch_add: ARMv6-M has no atomic read-modify-write, and this
-    // handler is the only writer.
-    let pulse = PULSES.load(Ordering::Relaxed);
-    PULSES.store(pulse.saturating_add(1), Ordering::Relaxed);
-    if pulse >= TRACE_SAMPLES {
+/// The body of the board timer's interrupt: one data-ready pulse of the emulated sensor,
+/// or, once the trace has been served, the end of the run (the timer stops).
+pub fn on_timer_interrupt(timer: &impl SampleTimer) {
+    timer.clear_interrupt();
+    if LINK.pulses() >= TRACE_SAMPLES {
         TRACE_DONE.store(true, Ordering::Release);
-        return false;
+        timer.stop();
+        return;
     }
-    irq::free(|cs| {
-        let mut sampler = SAMPLER.borrow(cs).borrow_mut();
-        let mut producer = PRODUCER.borrow(cs).borrow_mut();
-        if let (Some(sampler), Some(producer)) = (sampler.as_mut(), producer.as_mut()) {
-            sampler.on_data_ready(&mut |item| producer.enqueue(item).is_ok());
-        }
-    });
-    true
+    LINK.on_data_ready();
+}
+
+#[cortex_m_rt::exception]
+unsafe fn HardFault(ef: &cortex_m_rt::ExceptionFrame) -> ! {
+    defmt::error!("HardFault at pc={=u32:#x}", ef.pc());
+    fail();
+}
+
+#[panic_handler]
+fn panic(info: &core::panic::PanicInfo) -> ! {
+    defmt::error!("panic: {}", defmt::Display2Format(info));
+    fail();
 }
 
 /// Exits QEMU with a failure status.

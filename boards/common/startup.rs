@@ -78,6 +78,10 @@ impl Startup {
 
     /// Call after each sample the pipeline took; returns what to report, if anything.
     pub fn update<const M: usize>(&mut self, pipeline: &Pipeline<M>) -> Option<StartupEvent> {
+        // Called for every sample: once calibrated, nothing more to look at.
+        if self.stage == Stage::Done {
+            return None;
+        }
         let frame = pipeline.foot_frame();
         match self.stage {
             Stage::WaitingForRest => match frame {

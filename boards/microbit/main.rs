@@ -13,6 +13,9 @@ mod nrf51_timer;
 #[allow(dead_code)]
 #[path = "../common/imu_sampler.rs"]
 mod imu_sampler;
+#[allow(dead_code)]
+#[path = "../common/live_app.rs"]
+mod live_app;
 #[path = "../common/replay_app.rs"]
 mod replay_app;
 #[path = "../common/replay_mpu6050.rs"]
@@ -29,12 +32,12 @@ mod stride_log;
 mod trace;
 
 use cortex_m::peripheral::NVIC;
-use cortex_m_rt::{entry, exception, ExceptionFrame};
+use cortex_m_rt::{entry, exception};
 use defmt_semihosting as _;
 
 use gaitclip::pipeline::Pipeline;
 use nrf51_timer::{Nrf51Timer, TIMER0_BASE, TIMER0_IRQ};
-use replay_app::{fail, SampleTimer};
+use replay_app::{Irq, SampleTimer};
 use static_cell::ConstStaticCell;
 
 /// The nRF51 core clock, 16 MHz.
@@ -46,24 +49,15 @@ const CYCLES_PER_US: u32 = 16;
 /// the M4 build with its 1 024.
 const MOVEMENT_SAMPLES: usize = 256;
 
-/// TIMER0 as an NVIC interrupt number.
-#[derive(Clone, Copy)]
-struct Irq(u16);
-
-// Note(unsafe): `number` returns a valid external interrupt number of this device
-// (TIMER0 is IRQ 8 on the nRF51, which has 32 external interrupts).
-unsafe impl cortex_m::interrupt::InterruptNumber for Irq {
-    fn number(self) -> u16 {
-        self.0
-    }
-}
-
 impl SampleTimer for Nrf51Timer {
     fn start_periodic(&self, millihertz: u32) {
         Nrf51Timer::start_periodic(self, millihertz);
     }
     fn stop(&self) {
         Nrf51Timer::stop(self);
+    }
+    fn clear_interrupt(&self) {
+        Nrf51Timer::clear_interrupt(self);
     }
 }
 
@@ -89,22 +83,6 @@ fn main() -> ! {
 unsafe fn DefaultHandler(irqn: i16) {
     if irqn == TIMER0_IRQ as i16 {
         // Note(unsafe): TIMER0 is only acknowledged and stopped here; `main` only started it.
-        let timer = unsafe { Nrf51Timer::new(TIMER0_BASE) };
-        timer.clear_interrupt();
-        if !replay_app::on_data_ready() {
-            timer.stop();
-        }
+        replay_app::on_timer_interrupt(&unsafe { Nrf51Timer::new(TIMER0_BASE) });
     }
-}
-
-#[exception]
-unsafe fn HardFault(ef: &ExceptionFrame) -> ! {
-    defmt::error!("HardFault at pc={=u32:#x}", ef.pc());
-    fail();
-}
-
-#[panic_handler]
-fn panic(info: &core::panic::PanicInfo) -> ! {
-    defmt::error!("panic: {}", defmt::Display2Format(info));
-    fail();
 }

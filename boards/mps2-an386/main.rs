@@ -13,6 +13,9 @@ mod cmsdk_timer;
 #[allow(dead_code)]
 #[path = "../common/imu_sampler.rs"]
 mod imu_sampler;
+#[allow(dead_code)]
+#[path = "../common/live_app.rs"]
+mod live_app;
 #[path = "../common/replay_app.rs"]
 mod replay_app;
 #[path = "../common/replay_mpu6050.rs"]
@@ -29,29 +32,17 @@ mod stride_log;
 mod trace;
 
 use cortex_m::peripheral::NVIC;
-use cortex_m_rt::{entry, exception, ExceptionFrame};
+use cortex_m_rt::{entry, exception};
 use defmt_semihosting as _;
 use gaitclip::stride::MAX_MOVEMENT_SAMPLES;
 
 use cmsdk_timer::{CmsdkTimer, TIMER0_BASE, TIMER0_IRQ};
 use gaitclip::pipeline::Pipeline;
-use replay_app::{fail, SampleTimer};
+use replay_app::{Irq, SampleTimer};
 use static_cell::ConstStaticCell;
 
 /// The MPS2 core clock, 25 MHz.
 const CYCLES_PER_US: u32 = 25;
-
-/// TIMER0 as an NVIC interrupt number.
-#[derive(Clone, Copy)]
-struct Irq(u16);
-
-// Note(unsafe): `number` returns a valid external interrupt number of this device
-// (TIMER0 is IRQ 8 on AN386, which has 32 external interrupts).
-unsafe impl cortex_m::interrupt::InterruptNumber for Irq {
-    fn number(self) -> u16 {
-        self.0
-    }
-}
 
 impl SampleTimer for CmsdkTimer {
     fn start_periodic(&self, millihertz: u32) {
@@ -59,6 +50,9 @@ impl SampleTimer for CmsdkTimer {
     }
     fn stop(&self) {
         CmsdkTimer::stop(self);
+    }
+    fn clear_interrupt(&self) {
+        CmsdkTimer::clear_interrupt(self);
     }
 }
 
@@ -84,22 +78,6 @@ fn main() -> ! {
 unsafe fn DefaultHandler(irqn: i16) {
     if irqn == TIMER0_IRQ as i16 {
         // Note(unsafe): TIMER0 is only acknowledged and stopped here; `main` only started it.
-        let timer = unsafe { CmsdkTimer::new(TIMER0_BASE) };
-        timer.clear_interrupt();
-        if !replay_app::on_data_ready() {
-            timer.stop();
-        }
+        replay_app::on_timer_interrupt(&unsafe { CmsdkTimer::new(TIMER0_BASE) });
     }
-}
-
-#[exception]
-unsafe fn HardFault(ef: &ExceptionFrame) -> ! {
-    defmt::error!("HardFault at pc={=u32:#x}", ef.pc());
-    fail();
-}
-
-#[panic_handler]
-fn panic(info: &core::panic::PanicInfo) -> ! {
-    defmt::error!("panic: {}", defmt::Display2Format(info));
-    fail();
 }

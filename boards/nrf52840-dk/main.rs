@@ -35,7 +35,6 @@ mod startup;
 mod stride_log;
 
 use core::cell::RefCell;
-use core::sync::atomic::{AtomicU32, Ordering};
 
 use cortex_m::interrupt::{self as irq, Mutex};
 use cortex_m_rt::entry;
@@ -47,7 +46,7 @@ use gaitclip::pipeline::{Config, Pipeline};
 use gaitclip::rate::SampleRate;
 use gaitclip::sample::{AccelRange, GyroRange};
 use gaitclip::stride::MAX_MOVEMENT_SAMPLES;
-use heapless::spsc::{Producer, Queue};
+use heapless::spsc::Queue;
 use nrf52840_hal::{
     self as hal,
     gpio::{Floating, Input, Level, OpenDrainConfig, Pin},
@@ -60,8 +59,8 @@ use nrf52840_hal::{
 use panic_probe as _;
 use static_cell::ConstStaticCell;
 
-use imu_sampler::{BusRecovery, ImuSampler, Item, ReadMode};
-use live_app::{Watchdog, WATCHDOG_TICK_MS};
+use imu_sampler::{BusRecovery, Item, ReadMode};
+use live_app::{SampleLink, Watchdog, WATCHDOG_TICK_MS};
 use startup::Startup;
 use stride_log::StrideLog;
 
@@ -146,16 +145,12 @@ impl DelayNs for SpinDelay {
     }
 }
 
-type Sampler = ImuSampler<RecoverableTwim, SpinDelay>;
-
-static SAMPLER: Mutex<RefCell<Option<Sampler>>> = Mutex::new(RefCell::new(None));
-static PRODUCER: Mutex<RefCell<Option<Producer<'static, Item>>>> = Mutex::new(RefCell::new(None));
+/// Sampler, queue producer and pulse count, shared by the interrupts and the main loop.
+static LINK: SampleLink<RecoverableTwim, SpinDelay> = SampleLink::new();
 static GPIOTE: Mutex<RefCell<Option<Gpiote>>> = Mutex::new(RefCell::new(None));
 /// TIMER1, ticking the watchdog.
 type WatchdogTimer = Timer<TIMER1, Periodic>;
 static WATCHDOG: Mutex<RefCell<Option<(WatchdogTimer, Watchdog)>>> = Mutex::new(RefCell::new(None));
-/// Data-ready interrupts so far (written by the GPIOTE handler only).
-static PULSES: AtomicU32 = AtomicU32::new(0);
 static QUEUE: ConstStaticCell<Queue<Item, QUEUE_LEN>> = ConstStaticCell::new(Queue::new());
 static PIPELINE: ConstStaticCell<Pipeline<MAX_MOVEMENT_SAMPLES>> =
     ConstStaticCell::new(Pipeline::sized(Config::new(RATE, ACCEL, GYRO)));
@@ -196,29 +191,16 @@ fn main() -> ! {
             twim::Frequency::K400,
         )),
     };
-    let mut imu = Mpu6050::new(bus, Address::Ad0Low);
-    let mut delay = SpinDelay;
-    // A sensor that does not answer yet (still powering up, loose wire) is retried once a
-    // second, and said so, rather than given up on.
-    let sampler = loop {
-        match Sampler::start(imu, delay, SENSOR, ReadMode::Fifo { batch: FIFO_BATCH }) {
-            Ok(s) => break s,
-            Err((i, d, e)) => {
-                defmt::error!(
-                    "MPU6050 not ready ({}): check the wiring; retrying",
-                    defmt::Debug2Format(&e)
-                );
-                let _ = serial_line::comment(
-                    &mut serial,
-                    format_args!("MPU6050 not ready: check the wiring; retrying"),
-                );
-                (imu, delay) = (i, d);
-                delay.delay_ms(1000);
-            }
-        }
-    };
+    let sampler = live_app::start_sensor(
+        Mpu6050::new(bus, Address::Ad0Low),
+        SpinDelay,
+        SENSOR,
+        ReadMode::Fifo { batch: FIFO_BATCH },
+        &mut serial,
+    );
 
     let (producer, mut consumer) = QUEUE.take().split();
+    LINK.install(sampler, producer);
     let int_pin = port0.p0_03.into_floating_input().degrade();
     let gpiote = Gpiote::new(p.GPIOTE);
     gpiote
@@ -230,8 +212,6 @@ fn main() -> ! {
     timer.enable_interrupt();
     timer.start(WATCHDOG_TICK_MS * 1000); // 1 MHz timer clock
     irq::free(|cs| {
-        SAMPLER.borrow(cs).replace(Some(sampler));
-        PRODUCER.borrow(cs).replace(Some(producer));
         GPIOTE.borrow(cs).replace(Some(gpiote));
         WATCHDOG.borrow(cs).replace(Some((timer, Watchdog::new())));
     });
@@ -249,58 +229,28 @@ fn main() -> ! {
         &mut log,
         &mut serial,
         &mut startup,
-        || {
-            irq::free(|cs| {
-                SAMPLER
-                    .borrow(cs)
-                    .borrow()
-                    .as_ref()
-                    .map(|s| s.counters())
-                    .unwrap_or_default()
-            })
-        },
+        || LINK.counters(),
         RATE.samples_in_ms(live_app::STATUS_EVERY_MS),
     )
 }
 
-/// Pushes into the queue; `false` when it is full.
-fn push_with<'a>(producer: &'a mut Producer<'static, Item>) -> impl FnMut(Item) -> bool + 'a {
-    move |item| producer.enqueue(item).is_ok()
-}
-
 #[interrupt]
 fn GPIOTE() {
-    PULSES.store(
-        PULSES.load(Ordering::Relaxed).wrapping_add(1),
-        Ordering::Relaxed,
-    );
     irq::free(|cs| {
         if let Some(g) = GPIOTE.borrow(cs).borrow().as_ref() {
             g.channel0().reset_events();
         }
-        let mut sampler = SAMPLER.borrow(cs).borrow_mut();
-        let mut producer = PRODUCER.borrow(cs).borrow_mut();
-        if let (Some(s), Some(p)) = (sampler.as_mut(), producer.as_mut()) {
-            s.on_data_ready(&mut push_with(p));
-        }
     });
+    LINK.on_data_ready();
 }
 
 #[interrupt]
 fn TIMER1() {
     irq::free(|cs| {
         let mut wd = WATCHDOG.borrow(cs).borrow_mut();
-        let Some((timer, watchdog)) = wd.as_mut() else {
-            return;
-        };
-        timer.reset_event();
-        let per_tick = RATE.samples_in_ms(WATCHDOG_TICK_MS);
-        if let Some(lost) = watchdog.tick(PULSES.load(Ordering::Relaxed), per_tick) {
-            let mut sampler = SAMPLER.borrow(cs).borrow_mut();
-            let mut producer = PRODUCER.borrow(cs).borrow_mut();
-            if let (Some(s), Some(p)) = (sampler.as_mut(), producer.as_mut()) {
-                s.on_silence(lost, &mut push_with(p));
-            }
+        if let Some((timer, watchdog)) = wd.as_mut() {
+            timer.reset_event();
+            LINK.on_watchdog_tick(watchdog, RATE.samples_in_ms(WATCHDOG_TICK_MS));
         }
     });
 }

@@ -33,7 +33,6 @@ mod startup;
 mod stride_log;
 
 use core::cell::RefCell;
-use core::sync::atomic::{AtomicU32, Ordering};
 
 use cortex_m::interrupt::{self as irq, Mutex};
 use defmt_rtt as _;
@@ -46,7 +45,7 @@ use gaitclip::pipeline::{Config, Pipeline};
 use gaitclip::rate::SampleRate;
 use gaitclip::sample::{AccelRange, GyroRange};
 use gaitclip::stride::MAX_MOVEMENT_SAMPLES;
-use heapless::spsc::{Producer, Queue};
+use heapless::spsc::Queue;
 use panic_probe as _;
 use rp2040_hal::{
     self as hal,
@@ -63,8 +62,8 @@ use rp2040_hal::{
 };
 use static_cell::ConstStaticCell;
 
-use imu_sampler::{BusRecovery, ImuSampler, Item, ReadMode};
-use live_app::{Watchdog as SensorWatchdog, WATCHDOG_TICK_MS};
+use imu_sampler::{BusRecovery, Item, ReadMode};
+use live_app::{SampleLink, Watchdog as SensorWatchdog, WATCHDOG_TICK_MS};
 use startup::Startup;
 use stride_log::StrideLog;
 
@@ -163,15 +162,10 @@ impl DelayNs for SpinDelay {
     }
 }
 
-type Sampler = ImuSampler<RecoverableI2c, SpinDelay>;
-
-static SAMPLER: Mutex<RefCell<Option<Sampler>>> = Mutex::new(RefCell::new(None));
-static PRODUCER: Mutex<RefCell<Option<Producer<'static, Item>>>> = Mutex::new(RefCell::new(None));
+/// Sampler, queue producer and pulse count, shared by the interrupts and the main loop.
+static LINK: SampleLink<RecoverableI2c, SpinDelay> = SampleLink::new();
 static INT_PIN: Mutex<RefCell<Option<IntPin>>> = Mutex::new(RefCell::new(None));
 static WATCHDOG: Mutex<RefCell<Option<(Alarm0, SensorWatchdog)>>> = Mutex::new(RefCell::new(None));
-/// Data-ready interrupts so far (written by the GPIO handler only: ARMv6-M has no atomic
-/// read-modify-write, so it is a load and a store).
-static PULSES: AtomicU32 = AtomicU32::new(0);
 static QUEUE: ConstStaticCell<Queue<Item, QUEUE_LEN>> = ConstStaticCell::new(Queue::new());
 static PIPELINE: ConstStaticCell<Pipeline<MAX_MOVEMENT_SAMPLES>> =
     ConstStaticCell::new(Pipeline::sized(Config::new(RATE, ACCEL, GYRO)));
@@ -224,29 +218,16 @@ fn main() -> ! {
         resets: pac.RESETS,
         system_clock,
     };
-    let mut imu = Mpu6050::new(bus, Address::Ad0Low);
-    let mut delay = SpinDelay;
-    // A sensor that does not answer yet (still powering up, loose wire) is retried once a
-    // second, and said so, rather than given up on.
-    let sampler = loop {
-        match Sampler::start(imu, delay, SENSOR, ReadMode::Fifo { batch: FIFO_BATCH }) {
-            Ok(s) => break s,
-            Err((i, d, e)) => {
-                defmt::error!(
-                    "MPU6050 not ready ({}): check the wiring; retrying",
-                    defmt::Debug2Format(&e)
-                );
-                let _ = serial_line::comment(
-                    &mut serial,
-                    format_args!("MPU6050 not ready: check the wiring; retrying"),
-                );
-                (imu, delay) = (i, d);
-                delay.delay_ms(1000);
-            }
-        }
-    };
+    let sampler = live_app::start_sensor(
+        Mpu6050::new(bus, Address::Ad0Low),
+        SpinDelay,
+        SENSOR,
+        ReadMode::Fifo { batch: FIFO_BATCH },
+        &mut serial,
+    );
 
     let (producer, mut consumer) = QUEUE.take().split();
+    LINK.install(sampler, producer);
     let int_pin: IntPin = pins.gpio6.into_pull_down_input();
     int_pin.set_interrupt_enabled(PinInterrupt::EdgeHigh, true);
     let Some(mut alarm) = timer.alarm_0() else {
@@ -255,8 +236,6 @@ fn main() -> ! {
     let _ = alarm.schedule(fugit::MicrosDurationU32::millis(WATCHDOG_TICK_MS));
     alarm.enable_interrupt();
     irq::free(|cs| {
-        SAMPLER.borrow(cs).replace(Some(sampler));
-        PRODUCER.borrow(cs).replace(Some(producer));
         INT_PIN.borrow(cs).replace(Some(int_pin));
         WATCHDOG
             .borrow(cs)
@@ -276,59 +255,29 @@ fn main() -> ! {
         &mut log,
         &mut serial,
         &mut startup,
-        || {
-            irq::free(|cs| {
-                SAMPLER
-                    .borrow(cs)
-                    .borrow()
-                    .as_ref()
-                    .map(|s| s.counters())
-                    .unwrap_or_default()
-            })
-        },
+        || LINK.counters(),
         RATE.samples_in_ms(live_app::STATUS_EVERY_MS),
     )
 }
 
-/// Pushes into the queue; `false` when it is full.
-fn push_with<'a>(producer: &'a mut Producer<'static, Item>) -> impl FnMut(Item) -> bool + 'a {
-    move |item| producer.enqueue(item).is_ok()
-}
-
 #[interrupt]
 fn IO_IRQ_BANK0() {
-    PULSES.store(
-        PULSES.load(Ordering::Relaxed).wrapping_add(1),
-        Ordering::Relaxed,
-    );
     irq::free(|cs| {
         if let Some(pin) = INT_PIN.borrow(cs).borrow_mut().as_mut() {
             pin.clear_interrupt(PinInterrupt::EdgeHigh);
         }
-        let mut sampler = SAMPLER.borrow(cs).borrow_mut();
-        let mut producer = PRODUCER.borrow(cs).borrow_mut();
-        if let (Some(s), Some(p)) = (sampler.as_mut(), producer.as_mut()) {
-            s.on_data_ready(&mut push_with(p));
-        }
     });
+    LINK.on_data_ready();
 }
 
 #[interrupt]
 fn TIMER_IRQ_0() {
     irq::free(|cs| {
         let mut wd = WATCHDOG.borrow(cs).borrow_mut();
-        let Some((alarm, watchdog)) = wd.as_mut() else {
-            return;
-        };
-        alarm.clear_interrupt();
-        let _ = alarm.schedule(fugit::MicrosDurationU32::millis(WATCHDOG_TICK_MS));
-        let per_tick = RATE.samples_in_ms(WATCHDOG_TICK_MS);
-        if let Some(lost) = watchdog.tick(PULSES.load(Ordering::Relaxed), per_tick) {
-            let mut sampler = SAMPLER.borrow(cs).borrow_mut();
-            let mut producer = PRODUCER.borrow(cs).borrow_mut();
-            if let (Some(s), Some(p)) = (sampler.as_mut(), producer.as_mut()) {
-                s.on_silence(lost, &mut push_with(p));
-            }
+        if let Some((alarm, watchdog)) = wd.as_mut() {
+            alarm.clear_interrupt();
+            let _ = alarm.schedule(fugit::MicrosDurationU32::millis(WATCHDOG_TICK_MS));
+            LINK.on_watchdog_tick(watchdog, RATE.samples_in_ms(WATCHDOG_TICK_MS));
         }
     });
 }
