@@ -15,6 +15,17 @@ pub fn repo_root() -> PathBuf {
 /// repository root: `.` for the top-level crate, `boards/microbit` for a board with its own
 /// workspace) and returns the ELF path.
 pub fn build_in(dir: &str, bin: &str, target: &str) -> anyhow::Result<PathBuf> {
+    build_with(dir, bin, target, &[], &[])
+}
+
+/// [`build_in`] with extra cargo arguments (`--features …`) and environment variables.
+pub fn build_with(
+    dir: &str,
+    bin: &str,
+    target: &str,
+    args: &[&str],
+    env: &[(&str, &std::ffi::OsStr)],
+) -> anyhow::Result<PathBuf> {
     let root = repo_root().join(dir);
     let status = Command::new(std::env::var("CARGO").unwrap_or_else(|_| "cargo".into()))
         .current_dir(&root)
@@ -22,7 +33,9 @@ pub fn build_in(dir: &str, bin: &str, target: &str) -> anyhow::Result<PathBuf> {
         .env_remove("RUSTFLAGS")
         .env_remove("CARGO_ENCODED_RUSTFLAGS")
         .env_remove("CARGO_TARGET_DIR")
+        .envs(env.iter().copied())
         .args(["build", "--release", "--bin", bin, "--target", target])
+        .args(args)
         .status()
         .context("running cargo build for the firmware")?;
     if !status.success() {

@@ -19,6 +19,8 @@ pub struct RunOptions {
     /// Deterministic virtual time that skips idle periods (`-icount shift=0,sleep=off`): the
     /// run takes milliseconds instead of the trace's duration, and is repeatable.
     pub fast: bool,
+    /// Extra QEMU arguments (a `-plugin` for instruction counts, say).
+    pub extra_args: Vec<String>,
 }
 
 /// Output of a run.
@@ -54,6 +56,7 @@ pub fn run(
     if opts.fast {
         cmd.args(["-icount", "shift=0,sleep=off"]);
     }
+    cmd.args(&opts.extra_args);
     cmd.arg("-kernel").arg(elf);
     let mut child = cmd
         .stdout(Stdio::piped())

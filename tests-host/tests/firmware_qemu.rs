@@ -45,6 +45,7 @@ fn strides_equal_host_replay(dir: &str, bin: &str, target: &str, machine: &str) 
         &RunOptions {
             machine: machine.into(),
             fast: true,
+            extra_args: Vec::new(),
         },
         |_| {},
     )

@@ -25,6 +25,7 @@ fn main() -> ExitCode {
     let opts = RunOptions {
         machine: a.machine,
         fast: a.fast,
+        extra_args: Vec::new(),
     };
     match qemu::run(&a.elf, &opts, |l| println!("{l}")) {
         Ok(out) if out.status == 0 => ExitCode::SUCCESS,
