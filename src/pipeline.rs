@@ -255,6 +255,9 @@ impl<const M: usize> Pipeline<M> {
 
     /// Fills in the stride's length from the configured model; a malformed trained model
     /// falls back to the ZUPT displacement, which needs no training.
+    // Not inlined: the per-stride work stays out of the per-sample frame (stack), and
+    // `gaitclip cost` counts it apart from the sample path.
+    #[inline(never)]
     fn measure(&self, mut s: Stride) -> Stride {
         let f = Features::of(&s, self.rate);
         s.length_mm = models::predict_mm(self.model, &f, self.settings, self.params)

@@ -195,6 +195,8 @@ fn finish<const M: usize>(pipeline: &mut Pipeline<M>, log: &mut StrideLog, sampl
         log.stride(stride, serial);
     }
     log.summary(samples, &LINK.counters(), serial);
+    let (used, size) = crate::stack_paint::used_and_size();
+    defmt::println!("stack used={=u32} of {=u32} bytes", used, size);
     debug::exit(EXIT_SUCCESS);
     cortex_m::asm::udf()
 }

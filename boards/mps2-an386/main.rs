@@ -23,6 +23,8 @@ mod replay_mpu6050;
 #[allow(dead_code)]
 #[path = "../common/serial_line.rs"]
 mod serial_line;
+#[path = "../common/stack_paint.rs"]
+mod stack_paint;
 #[allow(dead_code)]
 #[path = "../common/startup.rs"]
 mod startup;
