@@ -2,6 +2,7 @@
 //! `no_std` core the firmware runs, simulate gait fixtures with ground truth, and run the
 //! firmware in QEMU with its defmt log decoded.
 
+pub mod cost;
 pub mod csv_trace;
 pub mod datasets;
 pub mod eval;

@@ -74,6 +74,26 @@ enum Cmd {
         #[arg(long, default_value = "../src/trained.rs")]
         out: PathBuf,
     },
+    /// Measure instructions per sample and stride (QEMU), firmware sizes and stacks, host
+    /// replay throughput against gaitmap; print Markdown. Run through `tests-host/cost.sh`,
+    /// which prepares the plugin, the criterion benchmark and gaitmap's figures.
+    Cost {
+        /// The qemu-insn-count plugin (.so).
+        #[arg(long)]
+        plugin: PathBuf,
+        /// criterion's estimates.json of benches/replay.rs.
+        #[arg(long)]
+        criterion: PathBuf,
+        /// JSON printed by gaitmap/bench_gaitmap.py.
+        #[arg(long)]
+        gaitmap: PathBuf,
+        /// The shared datasets folder.
+        #[arg(long, default_value = "../../shared/datasets")]
+        datasets: PathBuf,
+        /// Scratch folder.
+        #[arg(long, default_value = "target/cost")]
+        scratch: PathBuf,
+    },
     /// Regenerate the simulated fixtures (traces with ground truth) into a folder.
     Simulate {
         /// Output folder.
@@ -225,6 +245,23 @@ fn run(cli: Cli) -> anyhow::Result<()> {
                 t.trials,
                 out.display()
             );
+        }
+        Cmd::Cost {
+            plugin,
+            criterion,
+            gaitmap,
+            datasets,
+            scratch,
+        } => {
+            let abs = |p: PathBuf| std::path::absolute(&p).unwrap_or(p);
+            let report = gaitclip_host::cost::report(&gaitclip_host::cost::Inputs {
+                plugin: abs(plugin),
+                datasets: abs(datasets),
+                criterion_estimates: abs(criterion),
+                gaitmap_json: abs(gaitmap),
+                scratch: abs(scratch),
+            })?;
+            print!("{report}");
         }
         Cmd::Simulate { out } => {
             fixtures::write_all(&out)?;

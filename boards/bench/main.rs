@@ -1,0 +1,140 @@
+//! Cost benchmark firmware: replays a trace stored in flash through the core, with each step
+//! whose instructions `gaitclip cost` counts in a function of its own, called with `bl`:
+//!
+//! * [`bench_sample`]: one sample from its 14 register bytes through [`Pipeline::process`].
+//!   Inside it, the per-stride work runs in `StrideTracker::close` (phases, phase statistics,
+//!   ZUPT displacement) and `Pipeline::measure` (features and the default model), which
+//!   the counting plugin measures apart, so the per-sample figure is the sample path alone.
+//! * [`bench_features`] and [`bench_model`]: the features of each stride and every model this
+//!   build carries, one call each, in [`Model::ALL`] order (printed at the end).
+//!
+//! No interrupts run: the counts are the pipeline's own. The board is the QEMU machine of the
+//! target (mps2-an386 for thumbv7em, microbit for thumbv6m), with the movement buffer of the
+//! firmware that board ships.
+
+#![no_std]
+#![no_main]
+
+mod trace {
+    include!(concat!(env!("OUT_DIR"), "/trace.rs"));
+}
+
+use core::hint::black_box;
+
+use cortex_m_rt::{entry, exception};
+use cortex_m_semihosting::debug;
+use defmt_semihosting as _;
+use gaitclip::features::Features;
+use gaitclip::models::{self, Model, Settings};
+use gaitclip::pipeline::{Config, Pipeline};
+use gaitclip::rate::SampleRate;
+use gaitclip::sample::{AccelRange, GyroRange, RawSample, SAMPLE_BYTES};
+use gaitclip::stride::Stride;
+use static_cell::ConstStaticCell;
+
+/// The movement buffer of the firmware on the same board (see `boards/microbit/main.rs`).
+#[cfg(armv6m)]
+const MOVEMENT_SAMPLES: usize = 256;
+#[cfg(not(armv6m))]
+const MOVEMENT_SAMPLES: usize = gaitclip::stride::MAX_MOVEMENT_SAMPLES;
+
+const fn unwrap<T: Copy>(v: Option<T>) -> T {
+    match v {
+        Some(v) => v,
+        None => panic!("the trace module's rate and ranges are checked at compile time"),
+    }
+}
+
+const RATE: SampleRate = unwrap(SampleRate::from_millihertz(trace::RATE_MILLIHERTZ));
+const CONFIG: Config = Config::new(
+    RATE,
+    unwrap(AccelRange::from_afs_sel(trace::ACCEL_AFS_SEL)),
+    unwrap(GyroRange::from_fs_sel(trace::GYRO_FS_SEL)),
+);
+
+static PIPELINE: ConstStaticCell<Pipeline<MOVEMENT_SAMPLES>> =
+    ConstStaticCell::new(Pipeline::sized(CONFIG));
+
+#[entry]
+fn main() -> ! {
+    let pipeline = PIPELINE.take();
+    let (mut samples, mut strides, mut distance_mm) = (0u32, 0u32, 0u64);
+    let mut on_stride = |s: &Stride| {
+        strides += 1;
+        distance_mm += u64::from(s.length_mm);
+        let f = bench_features(s);
+        for model in Model::ALL {
+            if CONFIG.params.ships(model) {
+                bench_model(model, &f);
+            }
+        }
+    };
+    for block in trace::REGISTERS.chunks_exact(SAMPLE_BYTES) {
+        samples += 1;
+        if let Ok(regs) = <&[u8; SAMPLE_BYTES]>::try_from(block) {
+            if let Some(s) = bench_sample(pipeline, regs) {
+                on_stride(&s);
+            }
+        }
+    }
+    for s in pipeline.finish().iter().flatten() {
+        on_stride(s);
+    }
+    defmt::println!(
+        "bench samples={=u32} strides={=u32} distance_mm={=u64}",
+        samples,
+        strides,
+        distance_mm
+    );
+    // The order of the `bench_model` calls of each stride.
+    for model in Model::ALL.iter().filter(|m| CONFIG.params.ships(**m)) {
+        defmt::println!("bench model={=str}", model.name());
+    }
+    defmt::println!("bench default={=str}", CONFIG.model.name());
+    debug::exit(debug::EXIT_SUCCESS);
+    loop {
+        cortex_m::asm::wfi();
+    }
+}
+
+/// One sample through the per-sample path: decoding its registers and the pipeline.
+#[inline(never)]
+fn bench_sample(
+    pipeline: &mut Pipeline<MOVEMENT_SAMPLES>,
+    regs: &[u8; SAMPLE_BYTES],
+) -> Option<Stride> {
+    let s = RawSample::from_be_bytes(regs);
+    // black_box keeps the call a `bl` with a return (no tail call) for the counter to see.
+    black_box(pipeline.process(&s))
+}
+
+/// The features of one stride.
+#[inline(never)]
+fn bench_features(s: &Stride) -> Features {
+    black_box(Features::of(s, RATE))
+}
+
+/// One model's length of one stride.
+#[inline(never)]
+fn bench_model(model: Model, f: &Features) -> Option<u32> {
+    black_box(models::predict_mm(
+        model,
+        f,
+        Settings::DEFAULT,
+        CONFIG.params,
+    ))
+}
+
+#[exception]
+unsafe fn HardFault(_ef: &cortex_m_rt::ExceptionFrame) -> ! {
+    defmt::println!("bench: hard fault");
+    debug::exit(debug::EXIT_FAILURE);
+    loop {}
+}
+
+#[panic_handler]
+fn panic(info: &core::panic::PanicInfo) -> ! {
+    defmt::println!("bench: {}", defmt::Display2Format(info));
+    debug::exit(debug::EXIT_FAILURE);
+    loop {}
+}

@@ -1,0 +1,542 @@
+//! What gaitclip costs, measured (`gaitclip cost`, run by `tests-host/cost.sh`):
+//!
+//! * instructions per sample and per stride on the emulated Cortex-M4 (`mps2-an386`) and
+//!   Cortex-M0 (`microbit`): the benchmark firmware `boards/bench` replays a real trace from
+//!   flash and QEMU runs it with the `qemu-insn-count` plugin, which counts the instructions
+//!   of every call of the functions named in [`MEASURED`];
+//! * flash, static RAM and the stack's high-water mark of every firmware build;
+//! * host replay throughput (the criterion benchmark `benches/replay.rs`) next to gaitmap's
+//!   pipeline on the same trace (`tests-host/gaitmap/`).
+
+use std::collections::HashMap;
+use std::fmt::Write as _;
+use std::path::Path;
+
+use anyhow::{bail, ensure, Context, Result};
+use object::{Object, ObjectSection, ObjectSymbol, SectionFlags, SymbolKind};
+
+use crate::qemu::{self, RunOptions};
+
+/// The functions whose calls are counted: (key, demangled name without hash). The
+/// `bench::` ones are the benchmark firmware's wrappers; the others are the core's
+/// per-stride steps, out of line (`#[inline(never)]`) in every build.
+pub const MEASURED: [(&str, &str); 7] = [
+    ("sample", "bench::bench_sample"),
+    ("features", "bench::bench_features"),
+    ("model", "bench::bench_model"),
+    ("close", "gaitclip::stride::StrideTracker<_>::close"),
+    ("measure", "gaitclip::pipeline::Pipeline<_>::measure"),
+    ("split", "gaitclip::phases::split"),
+    ("stats", "gaitclip::phase_stats::StrideStats::measure"),
+];
+
+/// Instructions of each call of one function, in the order the calls returned.
+#[derive(Clone, Debug, Default)]
+pub struct Calls {
+    /// Callees included.
+    pub inclusive: Vec<u64>,
+    /// Without the calls of other measured functions made inside.
+    pub own: Vec<u64>,
+}
+
+/// Mean and maximum of a set of counts.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct Stat {
+    /// Number of values.
+    pub n: usize,
+    /// Mean.
+    pub mean: f64,
+    /// Maximum.
+    pub max: u64,
+}
+
+impl Stat {
+    /// Of `v` (all zero when empty).
+    pub fn of(v: &[u64]) -> Stat {
+        if v.is_empty() {
+            return Stat::default();
+        }
+        Stat {
+            n: v.len(),
+            mean: v.iter().sum::<u64>() as f64 / v.len() as f64,
+            max: v.iter().copied().max().unwrap_or(0),
+        }
+    }
+}
+
+/// Parses the plugin's output: `call NAME INCLUSIVE OWN` lines (any `open` or `lost` line
+/// is an error: a measured call whose return was not seen).
+pub fn parse_counts(text: &str) -> Result<HashMap<String, Calls>> {
+    let mut out: HashMap<String, Calls> = HashMap::new();
+    for (i, line) in text.lines().enumerate() {
+        let f: Vec<&str> = line.split_whitespace().collect();
+        match f.as_slice() {
+            ["call", name, inc, own] => {
+                let c = out.entry(name.to_string()).or_default();
+                c.inclusive
+                    .push(inc.parse().with_context(|| format!("line {}", i + 1))?);
+                c.own.push(own.parse().with_context(|| format!("line {}", i + 1))?);
+            }
+            ["total", _] => {}
+            _ => bail!("instruction counts, line {}: unexpected `{line}`", i + 1),
+        }
+    }
+    Ok(out)
+}
+
+/// Entry addresses of the [`MEASURED`] functions in `elf`.
+pub fn entry_addresses(elf: &[u8]) -> Result<Vec<(&'static str, u64)>> {
+    let file = object::File::parse(elf).context("parsing the ELF")?;
+    let mut found = Vec::new();
+    for (key, name) in MEASURED {
+        let addrs: Vec<u64> = file
+            .symbols()
+            .filter(|s| s.kind() == SymbolKind::Text)
+            .filter(|s| {
+                s.name()
+                    .is_ok_and(|n| format!("{:#}", rustc_demangle::demangle(n)) == name)
+            })
+            .map(|s| s.address())
+            .collect();
+        match addrs.as_slice() {
+            [a] => found.push((key, *a)),
+            [] => bail!("`{name}` is not in the ELF (inlined or renamed?)"),
+            _ => bail!("`{name}` is in the ELF {} times", addrs.len()),
+        }
+    }
+    Ok(found)
+}
+
+/// Instruction counts of one benchmark run.
+#[derive(Clone, Debug)]
+pub struct InsnReport {
+    /// QEMU machine.
+    pub machine: String,
+    /// Samples replayed.
+    pub samples: u32,
+    /// Strides found.
+    pub strides: u32,
+    /// Their summed length, mm.
+    pub distance_mm: u64,
+    /// The sample path: `Pipeline::process` without the per-stride steps.
+    pub sample: Stat,
+    /// Everything per sample, the per-stride steps spread over the samples (mean only).
+    pub sample_all_mean: f64,
+    /// `StrideTracker::close`: phases, phase statistics, ZUPT displacement.
+    pub close: Stat,
+    /// `phases::split` (inside close).
+    pub split: Stat,
+    /// `StrideStats::measure` (inside close).
+    pub stats: Stat,
+    /// `Pipeline::measure`: features and the default model.
+    pub measure: Stat,
+    /// close + measure of each stride: the pipeline's per-stride work.
+    pub stride: Stat,
+    /// `Features::of`.
+    pub features: Stat,
+    /// The default model's name.
+    pub default_model: String,
+    /// Each model the build carries: name and its `predict_mm` call.
+    pub models: Vec<(String, Stat)>,
+}
+
+/// Runs the benchmark firmware `elf` on `machine` under the counting plugin `plugin`.
+pub fn run_bench(elf: &Path, machine: &str, plugin: &Path, scratch: &Path) -> Result<InsnReport> {
+    let bytes = std::fs::read(elf).with_context(|| format!("reading {}", elf.display()))?;
+    let entries = entry_addresses(&bytes)?;
+    let out = scratch.join(format!("insn-count-{machine}.txt"));
+    let mut arg = plugin.display().to_string();
+    for (key, addr) in &entries {
+        let _ = write!(arg, ",fn={key}@{addr:#x}");
+    }
+    let _ = write!(arg, ",out={}", out.display());
+    let run = qemu::run(
+        elf,
+        &RunOptions {
+            machine: machine.into(),
+            fast: false,
+            extra_args: vec!["-plugin".into(), arg],
+        },
+        |_| {},
+    )?;
+    ensure!(
+        run.status == 0,
+        "benchmark firmware on {machine} exited with {}: {:?}",
+        run.status,
+        run.lines
+    );
+    let text = std::fs::read_to_string(&out)
+        .with_context(|| format!("reading the plugin's output {}", out.display()))?;
+    let calls = parse_counts(&text)?;
+    let get = |k: &str| calls.get(k).cloned().unwrap_or_default();
+    let (mut samples, mut strides, mut distance_mm) = (0, 0, 0);
+    let (mut models, mut default_model) = (Vec::new(), String::new());
+    for line in &run.lines {
+        if let Some(rest) = line.strip_prefix("bench samples=") {
+            let v: Vec<u64> = rest
+                .split(|c: char| !c.is_ascii_digit())
+                .filter_map(|t| t.parse().ok())
+                .collect();
+            ensure!(v.len() == 3, "bench summary `{line}`");
+            (samples, strides, distance_mm) = (v[0] as u32, v[1] as u32, v[2]);
+        } else if let Some(m) = line.strip_prefix("bench model=") {
+            models.push(m.to_string());
+        } else if let Some(m) = line.strip_prefix("bench default=") {
+            default_model = m.to_string();
+        }
+    }
+    let (sample, close, measure, model) = (get("sample"), get("close"), get("measure"), get("model"));
+    let n = strides as usize;
+    ensure!(
+        sample.own.len() == samples as usize,
+        "{machine}: {} sample calls counted for {samples} samples",
+        sample.own.len()
+    );
+    ensure!(
+        close.inclusive.len() == n && measure.inclusive.len() == n,
+        "{machine}: close/measure counted {}/{} times for {n} strides",
+        close.inclusive.len(),
+        measure.inclusive.len()
+    );
+    ensure!(
+        !models.is_empty() && model.inclusive.len() == n * models.len(),
+        "{machine}: {} model calls for {n} strides × {} models",
+        model.inclusive.len(),
+        models.len()
+    );
+    let per_stride: Vec<u64> = close
+        .inclusive
+        .iter()
+        .zip(&measure.inclusive)
+        .map(|(a, b)| a + b)
+        .collect();
+    let models = models
+        .iter()
+        .enumerate()
+        .map(|(k, name)| {
+            let v: Vec<u64> = model
+                .inclusive
+                .iter()
+                .skip(k)
+                .step_by(models.len())
+                .copied()
+                .collect();
+            (name.clone(), Stat::of(&v))
+        })
+        .collect();
+    Ok(InsnReport {
+        machine: machine.into(),
+        samples,
+        strides,
+        distance_mm,
+        sample: Stat::of(&sample.own),
+        sample_all_mean: sample.inclusive.iter().sum::<u64>() as f64 / samples.max(1) as f64,
+        close: Stat::of(&close.inclusive),
+        split: Stat::of(&get("split").inclusive),
+        stats: Stat::of(&get("stats").inclusive),
+        measure: Stat::of(&measure.inclusive),
+        stride: Stat::of(&per_stride),
+        features: Stat::of(&get("features").inclusive),
+        default_model,
+        models,
+    })
+}
+
+/// Flash and static RAM of a firmware ELF, bytes.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Size {
+    /// Allocated sections with contents (vector table, boot2, code, read-only data, the
+    /// initial values of `.data`).
+    pub flash: u64,
+    /// Allocated sections in RAM (0x2000_0000..0x4000_0000): `.data`, `.bss`, `.uninit`.
+    pub static_ram: u64,
+}
+
+/// [`Size`] of `elf`.
+pub fn size_of_elf(elf: &[u8]) -> Result<Size> {
+    let file = object::File::parse(elf).context("parsing the ELF")?;
+    let (mut flash, mut static_ram) = (0, 0);
+    for s in file.sections() {
+        let SectionFlags::Elf { sh_flags } = s.flags() else {
+            continue;
+        };
+        if sh_flags & u64::from(object::elf::SHF_ALLOC) == 0 {
+            continue;
+        }
+        if s.kind() != object::SectionKind::UninitializedData && s.size() > 0 {
+            flash += s.size();
+        }
+        if (0x2000_0000..0x4000_0000).contains(&s.address()) {
+            static_ram += s.size();
+        }
+    }
+    Ok(Size { flash, static_ram })
+}
+
+/// The `stack used=N of M bytes` line of a QEMU board's run.
+pub fn parse_stack_line(lines: &[String]) -> Option<(u32, u32)> {
+    lines.iter().find_map(|l| {
+        let rest = l.strip_prefix("stack used=")?;
+        let (used, rest) = rest.split_once(" of ")?;
+        let size = rest.strip_suffix(" bytes")?;
+        Some((used.parse().ok()?, size.parse().ok()?))
+    })
+}
+
+/// Mean samples per second of criterion's estimate file (`…/new/estimates.json`) for a
+/// benchmark of `elements` samples per iteration.
+pub fn criterion_samples_per_s(estimates_json: &str, elements: u64) -> Result<f64> {
+    let v: serde_json::Value = serde_json::from_str(estimates_json)?;
+    let ns = v["mean"]["point_estimate"]
+        .as_f64()
+        .context("criterion estimates without mean.point_estimate")?;
+    ensure!(ns > 0.0, "criterion mean of {ns} ns");
+    Ok(elements as f64 / (ns * 1e-9))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn parses_plugin_output_and_rejects_open_calls() {
+        let c = parse_counts("call sample 10 7\ncall sample 12 12\ntotal 99\n").unwrap();
+        assert_eq!(c["sample"].inclusive, vec![10, 12]);
+        assert_eq!(c["sample"].own, vec![7, 12]);
+        let s = Stat::of(&c["sample"].own);
+        assert_eq!((s.n, s.mean, s.max), (2, 9.5, 12));
+        assert!(parse_counts("open sample 5\n").is_err());
+        assert!(parse_counts("lost close\n").is_err());
+    }
+
+    #[test]
+    fn parses_stack_line() {
+        let l = vec!["summary x".to_string(), "stack used=7188 of 52056 bytes".into()];
+        assert_eq!(parse_stack_line(&l), Some((7188, 52056)));
+    }
+}
+
+/// Where `gaitclip cost` finds what `cost.sh` prepared.
+#[derive(Clone, Debug)]
+pub struct Inputs {
+    /// The built `qemu-insn-count` plugin.
+    pub plugin: std::path::PathBuf,
+    /// `../shared/datasets`.
+    pub datasets: std::path::PathBuf,
+    /// criterion's estimates of `benches/replay.rs`.
+    pub criterion_estimates: std::path::PathBuf,
+    /// The JSON line `gaitmap/bench_gaitmap.py` printed.
+    pub gaitmap_json: std::path::PathBuf,
+    /// Scratch folder (the trace module, the plugin's output).
+    pub scratch: std::path::PathBuf,
+}
+
+/// The trace every figure is measured on: a real recording, so that the stride work is
+/// that of real walking (26 strides per gaitmap's pipeline, 38.7 s).
+pub const TRACE: (&str, &str, f64) = ("gaitmap_walk", "left", 204.8);
+
+/// The firmware builds whose size is reported: (name, package folder, bin, target, QEMU
+/// machine it runs on, if any).
+pub const BUILDS: [(&str, &str, &str, &str, Option<&str>); 4] = [
+    ("mps2-an386 (QEMU, M4F)", ".", "mps2-an386", "thumbv7em-none-eabihf", Some(qemu::MACHINE_M4)),
+    ("microbit (QEMU, M0)", "boards/microbit", "microbit", "thumbv6m-none-eabi", Some(qemu::MACHINE_M0)),
+    ("nrf52840-dk (M4F)", "boards/nrf52840-dk", "nrf52840-dk", "thumbv7em-none-eabihf", None),
+    ("rp-pico (M0+)", "boards/rp-pico", "rp-pico", "thumbv6m-none-eabi", None),
+];
+
+/// Measures everything and returns the Markdown report.
+pub fn report(inp: &Inputs) -> Result<String> {
+    use crate::trace::Ranges;
+    std::fs::create_dir_all(&inp.scratch)?;
+    let (dataset, trial, rate_hz) = TRACE;
+    let csv = inp.datasets.join(dataset).join(format!("{trial}.csv"));
+    let trace = crate::csv_trace::read(&csv, Some(rate_hz))?;
+    let ranges = Ranges::default();
+    let counts: Vec<_> = trace.samples.iter().map(|s| ranges.to_counts(s)).collect();
+    let name = format!("{dataset}_{trial}");
+    crate::fixtures::write_trace_module(
+        &inp.scratch,
+        &name,
+        &format!("`{dataset}/{trial}.csv` for the cost benchmark; written by `gaitclip cost`."),
+        rate_hz,
+        ranges,
+        &counts,
+    )?;
+    let module = inp.scratch.join(format!("{name}.rs"));
+    let env = [("GAITCLIP_BENCH_TRACE", module.as_os_str())];
+    let config = gaitclip::pipeline::Config::new(
+        trace.sample_rate().context("trace rate")?,
+        ranges.accel,
+        ranges.gyro,
+    );
+    let host = crate::replay::core_strides(&counts, config);
+    let host_mm: u64 = host.iter().map(|s| u64::from(s.length_mm)).sum();
+
+    let mut insns = Vec::new();
+    for (target, machine, args) in [
+        ("thumbv7em-none-eabihf", qemu::MACHINE_M4, &["--features", "all-models"][..]),
+        ("thumbv6m-none-eabi", qemu::MACHINE_M0, &[][..]),
+    ] {
+        let elf = crate::firmware::build_with("boards/bench", "bench", target, args, &env)?;
+        let r = run_bench(&elf, machine, &inp.plugin, &inp.scratch)?;
+        ensure!(
+            r.samples as usize == counts.len(),
+            "{machine}: the benchmark replayed {} of {} samples",
+            r.samples,
+            counts.len()
+        );
+        if machine == qemu::MACHINE_M4 {
+            ensure!(
+                (r.strides as usize, r.distance_mm) == (host.len(), host_mm),
+                "{machine}: {} strides / {} mm, the host replay {} / {host_mm}",
+                r.strides,
+                r.distance_mm,
+                host.len()
+            );
+        }
+        insns.push(r);
+    }
+
+    let mut sizes = Vec::new();
+    for (label, dir, bin, target, machine) in BUILDS {
+        let elf = crate::firmware::build_in(dir, bin, target)?;
+        let size = size_of_elf(&std::fs::read(&elf)?)?;
+        let stack = match machine {
+            Some(m) => {
+                let run = qemu::run(
+                    &elf,
+                    &RunOptions {
+                        machine: m.into(),
+                        fast: true,
+                        extra_args: Vec::new(),
+                    },
+                    |_| {},
+                )?;
+                ensure!(run.status == 0, "{label} exited with {}", run.status);
+                Some(parse_stack_line(&run.lines).context("no `stack used` line")?)
+            }
+            None => None,
+        };
+        sizes.push((label, size, stack));
+    }
+
+    let estimates = std::fs::read_to_string(&inp.criterion_estimates).with_context(|| {
+        format!("reading {} (run benches/replay.rs)", inp.criterion_estimates.display())
+    })?;
+    let host_rate = criterion_samples_per_s(&estimates, counts.len() as u64)?;
+    let gm: serde_json::Value = serde_json::from_str(
+        &std::fs::read_to_string(&inp.gaitmap_json)
+            .with_context(|| format!("reading {}", inp.gaitmap_json.display()))?,
+    )?;
+    let gm_rate = gm["samples_per_s"].as_f64().context("gaitmap samples_per_s")?;
+
+    Ok(render(&Report {
+        trace: format!(
+            "`{dataset}/{trial}` ({} samples at {rate_hz} Hz, {} strides)",
+            counts.len(),
+            host.len()
+        ),
+        insns,
+        sizes,
+        host_rate,
+        gaitmap: gm,
+        gaitmap_rate: gm_rate,
+    }))
+}
+
+struct Report<'a> {
+    trace: String,
+    insns: Vec<InsnReport>,
+    sizes: Vec<(&'a str, Size, Option<(u32, u32)>)>,
+    host_rate: f64,
+    gaitmap: serde_json::Value,
+    gaitmap_rate: f64,
+}
+
+fn verdict(ok: bool) -> &'static str {
+    if ok {
+        "met"
+    } else {
+        "**not met**"
+    }
+}
+
+fn render(r: &Report) -> String {
+    let mut o = String::new();
+    let (m4, m0) = (&r.insns[0], &r.insns[1]);
+    let f = |s: &Stat| format!("{:.0} | {}", s.mean, s.max);
+    let _ = writeln!(o, "### Instructions\n");
+    let _ = writeln!(
+        o,
+        "Counted by the `qemu-insn-count` plugin on the benchmark firmware (`boards/bench`), \
+         which replays {} from flash; every call counted, callees included. The sample path \
+         leaves out the per-stride steps, listed below it.\n",
+        r.trace
+    );
+    let _ = writeln!(o, "| step | M4 mean | M4 max | M0 mean | M0 max |\n|---|---:|---:|---:|---:|");
+    let _ = writeln!(o, "| per sample: sample path | {} | {} |", f(&m4.sample), f(&m0.sample));
+    let _ = writeln!(
+        o,
+        "| per sample: all work, strides spread over the samples | {:.0} | | {:.0} | |",
+        m4.sample_all_mean, m0.sample_all_mean
+    );
+    let _ = writeln!(
+        o,
+        "| per stride: pipeline, default model (`{}`) | {} | {} |",
+        m4.default_model,
+        f(&m4.stride),
+        f(&m0.stride)
+    );
+    let _ = writeln!(o, "| · phases, statistics, ZUPT (`StrideTracker::close`) | {} | {} |", f(&m4.close), f(&m0.close));
+    let _ = writeln!(o, "| · · phase split (`phases::split`) | {} | {} |", f(&m4.split), f(&m0.split));
+    let _ = writeln!(o, "| · · phase statistics (`StrideStats::measure`) | {} | {} |", f(&m4.stats), f(&m0.stats));
+    let _ = writeln!(o, "| · features and default model (`Pipeline::measure`) | {} | {} |", f(&m4.measure), f(&m0.measure));
+    let _ = writeln!(o, "| features (`Features::of`) | {} | {} |", f(&m4.features), f(&m0.features));
+    for (name, s) in &m4.models {
+        let m0s = m0.models.iter().find(|(n, _)| n == name).map(|(_, s)| f(s));
+        let _ = writeln!(
+            o,
+            "| model `{name}` | {} | {} |",
+            f(s),
+            m0s.unwrap_or_else(|| "not in the M0 build | ".into())
+        );
+    }
+    let _ = writeln!(o, "\n### Size\n");
+    let _ = writeln!(
+        o,
+        "Release builds (`opt-level = \"s\"`, fat LTO). Flash: allocated sections with \
+         contents; static RAM: allocated sections in RAM; stack: high-water mark of the \
+         painted stack after replaying the demo walk in QEMU.\n"
+    );
+    let _ = writeln!(o, "| build | flash (B) | static RAM (B) | stack used / region (B) |\n|---|---:|---:|---:|");
+    for (label, s, stack) in &r.sizes {
+        let st = match stack {
+            Some((u, n)) => format!("{u} / {n}"),
+            None => "not run (no board here)".into(),
+        };
+        let _ = writeln!(o, "| {label} | {} | {} | {st} |", s.flash, s.static_ram);
+    }
+    let _ = writeln!(o, "\n### Host replay\n");
+    let _ = writeln!(
+        o,
+        "| pipeline on {} | samples/s |\n|---|---:|\n| gaitclip `replay` (criterion mean) | {:.0} |\n| gaitmap 2.6.0 MAD pipeline (median of {} runs after a first of {:.2} s) | {:.0} |\n| ratio | {:.0}× |",
+        r.trace,
+        r.host_rate,
+        r.gaitmap["runs"].as_u64().unwrap_or(0),
+        r.gaitmap["first_run_s"].as_f64().unwrap_or(f64::NAN),
+        r.gaitmap_rate,
+        r.host_rate / r.gaitmap_rate
+    );
+    let nrf = r.sizes.iter().find(|(l, _, _)| l.starts_with("nrf52840"));
+    let _ = writeln!(o, "\n### Goals\n\n| goal | measured | |\n|---|---:|---|");
+    let _ = writeln!(o, "| ≤ 150 instructions per sample on M4 (mean) | {:.0} | {} |", m4.sample.mean, verdict(m4.sample.mean <= 150.0));
+    let _ = writeln!(o, "| ≤ 400 instructions per sample on M0 (mean) | {:.0} | {} |", m0.sample.mean, verdict(m0.sample.mean <= 400.0));
+    let _ = writeln!(o, "| ≤ 30 000 instructions per stride, default model (M4 mean) | {:.0} | {} |", m4.stride.mean, verdict(m4.stride.mean <= 30_000.0));
+    if let Some((_, s, _)) = nrf {
+        let _ = writeln!(o, "| nRF52840 flash ≤ 48 KiB (49 152 B) | {} | {} |", s.flash, verdict(s.flash <= 49_152));
+        let _ = writeln!(o, "| nRF52840 static RAM ≤ 12 KiB (12 288 B) | {} | {} |", s.static_ram, verdict(s.static_ram <= 12_288));
+    }
+    let ratio = r.host_rate / r.gaitmap_rate;
+    let _ = writeln!(o, "| host replay ≥ 100× gaitmap | {ratio:.0}× | {} |", verdict(ratio >= 100.0));
+    o
+}
