@@ -3,7 +3,8 @@
 # workspace, firmware builds for both Cortex-M targets and every board (nRF52840-DK,
 # Raspberry Pi Pico, QEMU micro:bit), and the host test suite (driver transactions, fixed
 # point vs f64, fixtures, MCAP/CSV readers, real datasets when ../shared/datasets is
-# present, and the bit-exact QEMU runs of the M4 and M0 firmware).
+# present, the bit-exact QEMU runs of the M4 and M0 firmware, and the instruction counts of
+# the cost benchmark). The cost figures themselves come from tests-host/cost.sh.
 # Installs what a fresh Debian machine lacks: qemu-system-arm (apt) and flip-link (cargo).
 # rustup installs the toolchain, targets and components named in rust-toolchain.toml.
 set -euo pipefail
@@ -26,12 +27,18 @@ for board in nrf52840-dk rp-pico microbit; do
   (cd "$root/boards/$board" && cargo fmt --check && cargo clippy --release -- -D warnings && cargo build --release)
 done
 
-echo "== tests-host: rustfmt, clippy, tests"
+echo "== benchmark firmware (boards/bench): rustfmt, clippy, builds for both targets"
+(cd "$root/boards/bench" && cargo fmt --check &&
+  for t in thumbv7em-none-eabihf thumbv6m-none-eabi; do
+    cargo clippy --release --target "$t" -- -D warnings && cargo build --release --target "$t"
+  done)
+
+echo "== tests-host (and the qemu-insn-count plugin): rustfmt, clippy, tests"
 cd "$root/tests-host"
 cargo fmt --check
-cargo clippy --all-targets -- -D warnings
+cargo clippy --workspace --all-targets -- -D warnings
 log=$(mktemp)
-cargo test 2>&1 | tee "$log"
+cargo test --workspace 2>&1 | tee "$log"
 # One closing line over every test binary.
 awk '/^test result:/ { for (i = 1; i <= NF; i++) { if ($(i) ~ /^passed/) p += $(i-1); if ($(i) ~ /^failed/) f += $(i-1) } }
      END { printf "tests: %d passed, %d failed\n", p, f }' "$log"

@@ -129,12 +129,18 @@ fn bench_model(model: Model, f: &Features) -> Option<u32> {
 unsafe fn HardFault(_ef: &cortex_m_rt::ExceptionFrame) -> ! {
     defmt::println!("bench: hard fault");
     debug::exit(debug::EXIT_FAILURE);
-    loop {}
+    // Without a debugger attached semihosting returns: sleep.
+    loop {
+        cortex_m::asm::wfi();
+    }
 }
 
 #[panic_handler]
 fn panic(info: &core::panic::PanicInfo) -> ! {
     defmt::println!("bench: {}", defmt::Display2Format(info));
     debug::exit(debug::EXIT_FAILURE);
-    loop {}
+    // Without a debugger attached semihosting returns: sleep.
+    loop {
+        cortex_m::asm::wfi();
+    }
 }

@@ -75,7 +75,8 @@ pub fn parse_counts(text: &str) -> Result<HashMap<String, Calls>> {
                 let c = out.entry(name.to_string()).or_default();
                 c.inclusive
                     .push(inc.parse().with_context(|| format!("line {}", i + 1))?);
-                c.own.push(own.parse().with_context(|| format!("line {}", i + 1))?);
+                c.own
+                    .push(own.parse().with_context(|| format!("line {}", i + 1))?);
             }
             ["total", _] => {}
             _ => bail!("instruction counts, line {}: unexpected `{line}`", i + 1),
@@ -185,7 +186,8 @@ pub fn run_bench(elf: &Path, machine: &str, plugin: &Path, scratch: &Path) -> Re
             default_model = m.to_string();
         }
     }
-    let (sample, close, measure, model) = (get("sample"), get("close"), get("measure"), get("model"));
+    let (sample, close, measure, model) =
+        (get("sample"), get("close"), get("measure"), get("model"));
     let n = strides as usize;
     ensure!(
         sample.own.len() == samples as usize,
@@ -311,7 +313,10 @@ mod tests {
 
     #[test]
     fn parses_stack_line() {
-        let l = vec!["summary x".to_string(), "stack used=7188 of 52056 bytes".into()];
+        let l = vec![
+            "summary x".to_string(),
+            "stack used=7188 of 52056 bytes".into(),
+        ];
         assert_eq!(parse_stack_line(&l), Some((7188, 52056)));
     }
 }
@@ -338,10 +343,34 @@ pub const TRACE: (&str, &str, f64) = ("gaitmap_walk", "left", 204.8);
 /// The firmware builds whose size is reported: (name, package folder, bin, target, QEMU
 /// machine it runs on, if any).
 pub const BUILDS: [(&str, &str, &str, &str, Option<&str>); 4] = [
-    ("mps2-an386 (QEMU, M4F)", ".", "mps2-an386", "thumbv7em-none-eabihf", Some(qemu::MACHINE_M4)),
-    ("microbit (QEMU, M0)", "boards/microbit", "microbit", "thumbv6m-none-eabi", Some(qemu::MACHINE_M0)),
-    ("nrf52840-dk (M4F)", "boards/nrf52840-dk", "nrf52840-dk", "thumbv7em-none-eabihf", None),
-    ("rp-pico (M0+)", "boards/rp-pico", "rp-pico", "thumbv6m-none-eabi", None),
+    (
+        "mps2-an386 (QEMU, M4F)",
+        ".",
+        "mps2-an386",
+        "thumbv7em-none-eabihf",
+        Some(qemu::MACHINE_M4),
+    ),
+    (
+        "microbit (QEMU, M0)",
+        "boards/microbit",
+        "microbit",
+        "thumbv6m-none-eabi",
+        Some(qemu::MACHINE_M0),
+    ),
+    (
+        "nrf52840-dk (M4F)",
+        "boards/nrf52840-dk",
+        "nrf52840-dk",
+        "thumbv7em-none-eabihf",
+        None,
+    ),
+    (
+        "rp-pico (M0+)",
+        "boards/rp-pico",
+        "rp-pico",
+        "thumbv6m-none-eabi",
+        None,
+    ),
 ];
 
 /// Measures everything and returns the Markdown report.
@@ -374,7 +403,11 @@ pub fn report(inp: &Inputs) -> Result<String> {
 
     let mut insns = Vec::new();
     for (target, machine, args) in [
-        ("thumbv7em-none-eabihf", qemu::MACHINE_M4, &["--features", "all-models"][..]),
+        (
+            "thumbv7em-none-eabihf",
+            qemu::MACHINE_M4,
+            &["--features", "all-models"][..],
+        ),
         ("thumbv6m-none-eabi", qemu::MACHINE_M0, &[][..]),
     ] {
         let elf = crate::firmware::build_with("boards/bench", "bench", target, args, &env)?;
@@ -421,14 +454,19 @@ pub fn report(inp: &Inputs) -> Result<String> {
     }
 
     let estimates = std::fs::read_to_string(&inp.criterion_estimates).with_context(|| {
-        format!("reading {} (run benches/replay.rs)", inp.criterion_estimates.display())
+        format!(
+            "reading {} (run benches/replay.rs)",
+            inp.criterion_estimates.display()
+        )
     })?;
     let host_rate = criterion_samples_per_s(&estimates, counts.len() as u64)?;
     let gm: serde_json::Value = serde_json::from_str(
         &std::fs::read_to_string(&inp.gaitmap_json)
             .with_context(|| format!("reading {}", inp.gaitmap_json.display()))?,
     )?;
-    let gm_rate = gm["samples_per_s"].as_f64().context("gaitmap samples_per_s")?;
+    let gm_rate = gm["samples_per_s"]
+        .as_f64()
+        .context("gaitmap samples_per_s")?;
 
     Ok(render(&Report {
         trace: format!(
@@ -444,10 +482,13 @@ pub fn report(inp: &Inputs) -> Result<String> {
     }))
 }
 
+/// A build's name, size and stack (bytes used, region), where it was run.
+type BuildSize<'a> = (&'a str, Size, Option<(u32, u32)>);
+
 struct Report<'a> {
     trace: String,
     insns: Vec<InsnReport>,
-    sizes: Vec<(&'a str, Size, Option<(u32, u32)>)>,
+    sizes: Vec<BuildSize<'a>>,
     host_rate: f64,
     gaitmap: serde_json::Value,
     gaitmap_rate: f64,
@@ -473,8 +514,16 @@ fn render(r: &Report) -> String {
          leaves out the per-stride steps, listed below it.\n",
         r.trace
     );
-    let _ = writeln!(o, "| step | M4 mean | M4 max | M0 mean | M0 max |\n|---|---:|---:|---:|---:|");
-    let _ = writeln!(o, "| per sample: sample path | {} | {} |", f(&m4.sample), f(&m0.sample));
+    let _ = writeln!(
+        o,
+        "| step | M4 mean | M4 max | M0 mean | M0 max |\n|---|---:|---:|---:|---:|"
+    );
+    let _ = writeln!(
+        o,
+        "| per sample: sample path | {} | {} |",
+        f(&m4.sample),
+        f(&m0.sample)
+    );
     let _ = writeln!(
         o,
         "| per sample: all work, strides spread over the samples | {:.0} | | {:.0} | |",
@@ -487,11 +536,36 @@ fn render(r: &Report) -> String {
         f(&m4.stride),
         f(&m0.stride)
     );
-    let _ = writeln!(o, "| · phases, statistics, ZUPT (`StrideTracker::close`) | {} | {} |", f(&m4.close), f(&m0.close));
-    let _ = writeln!(o, "| · · phase split (`phases::split`) | {} | {} |", f(&m4.split), f(&m0.split));
-    let _ = writeln!(o, "| · · phase statistics (`StrideStats::measure`) | {} | {} |", f(&m4.stats), f(&m0.stats));
-    let _ = writeln!(o, "| · features and default model (`Pipeline::measure`) | {} | {} |", f(&m4.measure), f(&m0.measure));
-    let _ = writeln!(o, "| features (`Features::of`) | {} | {} |", f(&m4.features), f(&m0.features));
+    let _ = writeln!(
+        o,
+        "| · phases, statistics, ZUPT (`StrideTracker::close`) | {} | {} |",
+        f(&m4.close),
+        f(&m0.close)
+    );
+    let _ = writeln!(
+        o,
+        "| · · phase split (`phases::split`) | {} | {} |",
+        f(&m4.split),
+        f(&m0.split)
+    );
+    let _ = writeln!(
+        o,
+        "| · · phase statistics (`StrideStats::measure`) | {} | {} |",
+        f(&m4.stats),
+        f(&m0.stats)
+    );
+    let _ = writeln!(
+        o,
+        "| · features and default model (`Pipeline::measure`) | {} | {} |",
+        f(&m4.measure),
+        f(&m0.measure)
+    );
+    let _ = writeln!(
+        o,
+        "| features (`Features::of`) | {} | {} |",
+        f(&m4.features),
+        f(&m0.features)
+    );
     for (name, s) in &m4.models {
         let m0s = m0.models.iter().find(|(n, _)| n == name).map(|(_, s)| f(s));
         let _ = writeln!(
@@ -508,7 +582,10 @@ fn render(r: &Report) -> String {
          contents; static RAM: allocated sections in RAM; stack: high-water mark of the \
          painted stack after replaying the demo walk in QEMU.\n"
     );
-    let _ = writeln!(o, "| build | flash (B) | static RAM (B) | stack used / region (B) |\n|---|---:|---:|---:|");
+    let _ = writeln!(
+        o,
+        "| build | flash (B) | static RAM (B) | stack used / region (B) |\n|---|---:|---:|---:|"
+    );
     for (label, s, stack) in &r.sizes {
         let st = match stack {
             Some((u, n)) => format!("{u} / {n}"),
@@ -529,14 +606,43 @@ fn render(r: &Report) -> String {
     );
     let nrf = r.sizes.iter().find(|(l, _, _)| l.starts_with("nrf52840"));
     let _ = writeln!(o, "\n### Goals\n\n| goal | measured | |\n|---|---:|---|");
-    let _ = writeln!(o, "| ≤ 150 instructions per sample on M4 (mean) | {:.0} | {} |", m4.sample.mean, verdict(m4.sample.mean <= 150.0));
-    let _ = writeln!(o, "| ≤ 400 instructions per sample on M0 (mean) | {:.0} | {} |", m0.sample.mean, verdict(m0.sample.mean <= 400.0));
-    let _ = writeln!(o, "| ≤ 30 000 instructions per stride, default model (M4 mean) | {:.0} | {} |", m4.stride.mean, verdict(m4.stride.mean <= 30_000.0));
+    let _ = writeln!(
+        o,
+        "| ≤ 150 instructions per sample on M4 (mean) | {:.0} | {} |",
+        m4.sample.mean,
+        verdict(m4.sample.mean <= 150.0)
+    );
+    let _ = writeln!(
+        o,
+        "| ≤ 400 instructions per sample on M0 (mean) | {:.0} | {} |",
+        m0.sample.mean,
+        verdict(m0.sample.mean <= 400.0)
+    );
+    let _ = writeln!(
+        o,
+        "| ≤ 30 000 instructions per stride, default model (M4 mean) | {:.0} | {} |",
+        m4.stride.mean,
+        verdict(m4.stride.mean <= 30_000.0)
+    );
     if let Some((_, s, _)) = nrf {
-        let _ = writeln!(o, "| nRF52840 flash ≤ 48 KiB (49 152 B) | {} | {} |", s.flash, verdict(s.flash <= 49_152));
-        let _ = writeln!(o, "| nRF52840 static RAM ≤ 12 KiB (12 288 B) | {} | {} |", s.static_ram, verdict(s.static_ram <= 12_288));
+        let _ = writeln!(
+            o,
+            "| nRF52840 flash ≤ 48 KiB (49 152 B) | {} | {} |",
+            s.flash,
+            verdict(s.flash <= 49_152)
+        );
+        let _ = writeln!(
+            o,
+            "| nRF52840 static RAM ≤ 12 KiB (12 288 B) | {} | {} |",
+            s.static_ram,
+            verdict(s.static_ram <= 12_288)
+        );
     }
     let ratio = r.host_rate / r.gaitmap_rate;
-    let _ = writeln!(o, "| host replay ≥ 100× gaitmap | {ratio:.0}× | {} |", verdict(ratio >= 100.0));
+    let _ = writeln!(
+        o,
+        "| host replay ≥ 100× gaitmap | {ratio:.0}× | {} |",
+        verdict(ratio >= 100.0)
+    );
     o
 }

@@ -150,7 +150,8 @@ unsafe extern "C" fn on_translate(_id: qemu_plugin_id_t, tb: *mut qemu_plugin_tb
                 );
             }
             if qemu_plugin_insn_size(insn) == 4 {
-                let bytes = core::slice::from_raw_parts(qemu_plugin_insn_data(insn) as *const u8, 4);
+                let bytes =
+                    core::slice::from_raw_parts(qemu_plugin_insn_data(insn) as *const u8, 4);
                 let h1 = u16::from_le_bytes([bytes[0], bytes[1]]);
                 let h2 = u16::from_le_bytes([bytes[2], bytes[3]]);
                 if let Some(&function) = bl_target(pc, h1, h2).and_then(|t| state.entries.get(&t)) {
@@ -198,7 +199,9 @@ fn parse_args(args: &[String]) -> Result<State, String> {
         } else if let Some(v) = arg.strip_prefix("out=") {
             state.out = v.to_string();
         } else {
-            return Err(format!("unknown argument `{arg}` (fn=NAME@0xADDR, out=PATH)"));
+            return Err(format!(
+                "unknown argument `{arg}` (fn=NAME@0xADDR, out=PATH)"
+            ));
         }
     }
     if state.out.is_empty() {
@@ -220,7 +223,11 @@ pub unsafe extern "C" fn qemu_plugin_install(
 ) -> c_int {
     let args: Vec<String> = (0..argc.max(0) as usize)
         // Note(unsafe): QEMU passes argc NUL-terminated strings.
-        .map(|i| unsafe { CStr::from_ptr(*argv.add(i)) }.to_string_lossy().into_owned())
+        .map(|i| {
+            unsafe { CStr::from_ptr(*argv.add(i)) }
+                .to_string_lossy()
+                .into_owned()
+        })
         .collect();
     match parse_args(&args) {
         Ok(state) => {

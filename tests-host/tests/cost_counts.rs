@@ -1,0 +1,95 @@
+//! The instruction counts of `gaitclip cost` are sound and repeatable: the benchmark firmware
+//! (demo walk from flash) under the `qemu-insn-count` plugin finds the host replay's strides,
+//! every measured call returns, and a second run counts exactly the same.
+
+use gaitclip_host::cost::{self, size_of_elf};
+use gaitclip_host::firmware::{self, repo_root};
+use gaitclip_host::qemu;
+use gaitclip_host::replay::core_strides;
+
+fn qemu_or_skip() -> bool {
+    let ok = std::process::Command::new("qemu-system-arm")
+        .arg("--version")
+        .output()
+        .is_ok_and(|o| o.status.success());
+    if !ok {
+        assert!(
+            !std::env::var("CI").is_ok_and(|v| v == "true"),
+            "qemu-system-arm is missing in CI (apt-get install qemu-system-arm)"
+        );
+        eprintln!("SKIPPED: qemu-system-arm is not installed");
+    }
+    ok
+}
+
+fn plugin() -> std::path::PathBuf {
+    let dir = repo_root().join("tests-host");
+    let status = std::process::Command::new(std::env::var("CARGO").unwrap_or("cargo".into()))
+        .current_dir(&dir)
+        .args([
+            "build",
+            "--release",
+            "--quiet",
+            "-p",
+            "qemu-insn-count",
+            "--message-format=json",
+        ])
+        .output()
+        .expect("cargo runs");
+    assert!(status.status.success(), "the plugin builds");
+    // The cdylib's path, from cargo's own report of what it built.
+    String::from_utf8_lossy(&status.stdout)
+        .lines()
+        .filter_map(|l| serde_json::from_str::<serde_json::Value>(l).ok())
+        .filter(|v| v["target"]["name"] == "qemu_insn_count")
+        .flat_map(|v| v["filenames"].as_array().cloned().unwrap_or_default())
+        .filter_map(|f| f.as_str().map(std::path::PathBuf::from))
+        .find(|p| p.extension().is_some_and(|e| e == "so"))
+        .expect("cargo reports the plugin's .so")
+}
+
+#[test]
+fn bench_counts_are_complete_and_repeatable_on_m4() {
+    if !qemu_or_skip() {
+        return;
+    }
+    let elf = firmware::build_in("boards/bench", "bench", "thumbv7em-none-eabihf")
+        .expect("the benchmark firmware builds");
+    let plugin = plugin();
+    let scratch = tempdir();
+    let a = cost::run_bench(&elf, qemu::MACHINE_M4, &plugin, &scratch).expect("counted run");
+    let b = cost::run_bench(&elf, qemu::MACHINE_M4, &plugin, &scratch).expect("counted run");
+
+    let counts = gaitclip_host::fixtures::firmware_trace_counts().expect("demo trace");
+    let config = gaitclip::pipeline::Config::new(
+        gaitclip::rate::SampleRate::from_millihertz(200_000).expect("200 Hz"),
+        gaitclip::sample::AccelRange::G16,
+        gaitclip::sample::GyroRange::Dps2000,
+    );
+    let host = core_strides(&counts, config);
+    assert_eq!(a.samples as usize, counts.len());
+    assert_eq!(a.strides as usize, host.len());
+    assert_eq!(
+        a.distance_mm,
+        host.iter().map(|s| u64::from(s.length_mm)).sum::<u64>()
+    );
+    // Same ELF, same input: same counts, to the instruction.
+    assert_eq!(a.sample, b.sample);
+    assert_eq!(a.stride, b.stride);
+    assert_eq!(a.models.len(), b.models.len());
+    for ((na, sa), (nb, sb)) in a.models.iter().zip(&b.models) {
+        assert_eq!((na, sa), (nb, sb));
+    }
+    // The per-stride steps nest: split and statistics inside close.
+    assert!(a.split.mean + a.stats.mean < a.close.mean);
+    assert!(a.sample.mean > 0.0 && a.sample.max as f64 >= a.sample.mean);
+    assert!(size_of_elf(&std::fs::read(&elf).unwrap()).unwrap().flash > 0);
+}
+
+fn tempdir() -> std::path::PathBuf {
+    let d = repo_root()
+        .join("tests-host/target/cost-test")
+        .join(std::process::id().to_string());
+    std::fs::create_dir_all(&d).expect("scratch folder");
+    d
+}
