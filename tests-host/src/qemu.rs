@@ -11,6 +11,23 @@ pub const MACHINE_M4: &str = "mps2-an386";
 /// The Cortex-M0 machine: BBC micro:bit (nRF51822, 16 KiB RAM).
 pub const MACHINE_M0: &str = "microbit";
 
+/// For tests: true when `qemu-system-arm` runs; otherwise prints that the test was
+/// skipped and returns false. In CI (`CI=true`) a missing QEMU is a failure, not a skip.
+pub fn available_or_skip() -> bool {
+    let ok = Command::new("qemu-system-arm")
+        .arg("--version")
+        .output()
+        .is_ok_and(|o| o.status.success());
+    if !ok {
+        assert!(
+            !std::env::var("CI").is_ok_and(|v| v == "true"),
+            "qemu-system-arm is missing in CI (apt-get install qemu-system-arm)"
+        );
+        eprintln!("SKIPPED: qemu-system-arm is not installed");
+    }
+    ok
+}
+
 /// How to run.
 #[derive(Clone, Debug)]
 pub struct RunOptions {

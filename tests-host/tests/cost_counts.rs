@@ -7,21 +7,6 @@ use gaitclip_host::firmware::{self, repo_root};
 use gaitclip_host::qemu;
 use gaitclip_host::replay::core_strides;
 
-fn qemu_or_skip() -> bool {
-    let ok = std::process::Command::new("qemu-system-arm")
-        .arg("--version")
-        .output()
-        .is_ok_and(|o| o.status.success());
-    if !ok {
-        assert!(
-            !std::env::var("CI").is_ok_and(|v| v == "true"),
-            "qemu-system-arm is missing in CI (apt-get install qemu-system-arm)"
-        );
-        eprintln!("SKIPPED: qemu-system-arm is not installed");
-    }
-    ok
-}
-
 fn plugin() -> std::path::PathBuf {
     let dir = repo_root().join("tests-host");
     let status = std::process::Command::new(std::env::var("CARGO").unwrap_or("cargo".into()))
@@ -50,7 +35,7 @@ fn plugin() -> std::path::PathBuf {
 
 #[test]
 fn bench_counts_are_complete_and_repeatable_on_m4() {
-    if !qemu_or_skip() {
+    if !qemu::available_or_skip() {
         return;
     }
     let elf = firmware::build_in("boards/bench", "bench", "thumbv7em-none-eabihf")

@@ -9,13 +9,6 @@ use gaitclip_host::qemu::{self, RunOptions};
 use gaitclip_host::replay::replay_counts;
 use gaitclip_host::trace::Ranges;
 
-fn qemu_available() -> bool {
-    std::process::Command::new("qemu-system-arm")
-        .arg("--version")
-        .output()
-        .is_ok_and(|o| o.status.success())
-}
-
 #[test]
 fn qemu_m4_strides_equal_host_replay() {
     strides_equal_host_replay(".", "mps2-an386", "thumbv7em-none-eabihf", qemu::MACHINE_M4);
@@ -32,11 +25,7 @@ fn qemu_m0_strides_equal_host_replay() {
 }
 
 fn strides_equal_host_replay(dir: &str, bin: &str, target: &str, machine: &str) {
-    if !qemu_available() {
-        if std::env::var("CI").is_ok_and(|v| v == "true") {
-            panic!("qemu-system-arm is missing in CI (apt-get install qemu-system-arm)");
-        }
-        eprintln!("SKIPPED: qemu-system-arm is not installed");
+    if !qemu::available_or_skip() {
         return;
     }
     let elf = firmware::build_in(dir, bin, target).expect("firmware builds");
