@@ -179,6 +179,15 @@ impl FootFrameEstimator {
         self.was_rest = rest;
     }
 
+    /// Samples were lost. A movement in progress has a hole, so its axis and the sign of its
+    /// first moment mean nothing: it is not learnt from (marked full, as a movement too long
+    /// to learn from is). A rest in progress goes on: its samples are gravity either side.
+    pub fn gap(&mut self) {
+        if !self.was_rest {
+            self.move_n = self.axis_max;
+        }
+    }
+
     fn accumulate_rest(&mut self, s: &RawSample) {
         self.rest.add(s);
         if self.frame.is_none() && self.rest.count == self.first_after {

@@ -21,7 +21,7 @@ use crate::rate::SampleRate;
 use crate::rest::{RestDetector, RestThresholds};
 use crate::sample::{AccelRange, GyroRange, RawSample};
 use crate::stance::{StanceDetector, StanceThresholds};
-use crate::stride::{Stride, StrideTracker, MAX_MOVEMENT_SAMPLES};
+use crate::stride::{Stride, StrideFlags, StrideTracker, MAX_MOVEMENT_SAMPLES, MAX_STRIDE_MM};
 
 /// Capacity of the mean filter; the window used is the power of two nearest
 /// [`MEAN_FILTER_MS`] at the sample rate, at most this.
@@ -211,25 +211,57 @@ impl<const M: usize> Pipeline<M> {
         stride.map(|s| self.measure(s))
     }
 
-    /// Declares `missing` samples lost (FIFO overflow, a jump in timestamps): the movement
-    /// in progress is dropped, since no length over a gap can be trusted, and detection
-    /// restarts after it. Returns the last stride closed before the gap, still held.
+    /// Declares `missing` samples lost (FIFO overflow, a sensor that stopped answering, a
+    /// jump in timestamps). The samples still in the delay line are drained as at
+    /// [`Pipeline::finish`], the stride in progress becomes a
+    /// [`crate::stride::StrideFlags::GAP`] stride (no length, reported once the next stance
+    /// is found after the gap), and detection restarts after it. Returns the stride the drain
+    /// let the tracker report or that it held, complete and measured as usual.
+    // Not inlined: its strides would otherwise sit in the caller's frame on the sample path.
+    #[inline(never)]
     pub fn gap(&mut self, missing: u32) -> Option<Stride> {
+        // The drain runs on one stance decision, so it makes one transition at most, and
+        // then the tracker holds nothing to hand back; should both ever carry a stride, the
+        // later one stays held (reported after the gap), so nothing is lost.
+        let drained = self.drain();
+        let out = match (drained, self.tracker.gap()) {
+            (Some(a), Some(b)) => {
+                self.tracker.hold(b);
+                Some(a)
+            }
+            (a, b) => a.or(b),
+        };
         self.next = self.next.wrapping_add(missing);
         self.since_reset = 0;
         self.stance_fed = 0;
         self.filter = MeanFilter::with_len_log2(self.filter.window().trailing_zeros());
         self.rest.reset();
+        self.frame.gap();
         self.stance.reset();
-        let stride = self.tracker.reset();
-        stride.map(|s| self.measure(s))
+        // Measured last and once: a single stride on this frame while the models run keeps
+        // the gap path's stack no deeper than a sample's.
+        out.map(|s| self.measure(s))
     }
 
     /// Drains the samples still in the delay line at the end of a recording, with the last
     /// stance decision, and returns the strides still held (at most two: one closed by the
-    /// drained samples, one waiting for its following stance to end).
+    /// drained samples, one waiting for its following stance to end, or a gap stride still
+    /// open).
     pub fn finish(&mut self) -> [Option<Stride>; 2] {
-        let mut out = [None, None];
+        let first = self.drain().or_else(|| self.tracker.finish());
+        let out = [
+            first.map(|s| self.measure(s)),
+            self.tracker.finish().map(|s| self.measure(s)),
+        ];
+        self.since_reset = 0;
+        self.stance_fed = 0;
+        out
+    }
+
+    /// Feeds the tracker the samples still in the delay line, with the last stance decision;
+    /// returns the stride they let it report, if any, not yet measured.
+    fn drain(&mut self) -> Option<Stride> {
+        let mut closed = None;
         // The tracker has had samples up to `next − 1 − delay`; the foot-frame values reach
         // `next − 1 − filter delay`, so that many more can be drained.
         let fd = self.filter.delay();
@@ -244,13 +276,12 @@ impl<const M: usize> Pipeline<M> {
             let foot_at = at.wrapping_add(fd);
             let (raw, foot) = (self.raw_line[slot(at)], self.foot_line[slot(foot_at)]);
             if let Some(st) = self.tracker.process(at, &raw, foot, self.last_decision) {
-                out[0] = Some(self.measure(st));
+                closed = Some(st);
             }
         }
-        out[1] = self.tracker.finish().map(|s| self.measure(s));
-        self.since_reset = 0;
+        // Drained once: a second drain before new samples would feed them again.
         self.stance_fed = 0;
-        out
+        closed
     }
 
     /// Fills in the stride's length from the configured model; a malformed trained model
@@ -259,10 +290,18 @@ impl<const M: usize> Pipeline<M> {
     // `gaitclip cost` counts it apart from the sample path.
     #[inline(never)]
     fn measure(&self, mut s: Stride) -> Stride {
+        if s.flags.has(StrideFlags::GAP) {
+            // No length across a gap; `length_mm` stays 0.
+            return s;
+        }
         let f = Features::of(&s, self.rate);
-        s.length_mm = models::predict_mm(self.model, &f, self.settings, self.params)
+        let mm = models::predict_mm(self.model, &f, self.settings, self.params)
             .or_else(|| models::predict_mm(Model::Zupt, &f, self.settings, self.params))
             .unwrap_or(0);
+        if mm > MAX_STRIDE_MM {
+            s.flags.0 |= StrideFlags::IMPLAUSIBLE;
+        }
+        s.length_mm = mm.min(MAX_STRIDE_MM);
         s
     }
 }

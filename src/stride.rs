@@ -21,7 +21,13 @@
 //! [`StrideFlags::TURN`]. To know whether a stride was the last one, a stride is reported
 //! when the stance after it ends (the next heel-off), or once that stance has lasted
 //! [`MAX_STANCE_IN_STRIDE_MS`]: the latency is the following stance, at most one second.
-//! A gap in the samples drops the movement in progress: no stride is ever emitted across one.
+//!
+//! **Gaps.** A gap in the samples (a FIFO overflow, a sensor that stopped answering, a jump
+//! in a recording's timestamps) leaves the stride around it without a trustworthy length or
+//! events. It is still reported, once, flagged [`StrideFlags::GAP`] and with no length, so that
+//! a stride count stays right and nothing is silently measured across the hole: a stride is a
+//! gap stride when the gap fell into its movement, or into the stance before a movement that
+//! followed the gap. A gap inside a stance that goes on after it costs nothing.
 //!
 //! Streaming and bounded: the only per-stride memory is the movement's foot-frame
 //! acceleration, a buffer of `M` samples ([`MAX_MOVEMENT_SAMPLES`] unless a board with
@@ -48,6 +54,11 @@ pub const MIN_MOVEMENT_MS: u32 = 150;
 /// for a minute before walking has a first stride of one step, not of a minute.
 pub const MAX_STANCE_IN_STRIDE_MS: u32 = 1000;
 
+/// The longest stride a person makes, mm: an elite sprinter's stride (two steps) is about
+/// 5 m. A model that says more was fed something else, and the stride is flagged
+/// [`StrideFlags::IMPLAUSIBLE`].
+pub const MAX_STRIDE_MM: u32 = 6000;
+
 /// Properties of a stride that qualify its length.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
 pub struct StrideFlags(pub u8);
@@ -68,8 +79,13 @@ impl StrideFlags {
     /// The phase splitter found no major peak-valley pair for a boundary: toe-off and
     /// heel-strike are cluster centres, not measured events.
     pub const PHASES_GUESSED: u8 = 1 << 5;
+    /// Samples were lost inside the stride (a gap): it has no length, and its events after
+    /// the gap are unknown (toe-off and heel-strike are set to the first missing sample).
+    pub const GAP: u8 = 1 << 6;
+    /// The length model gave more than [`MAX_STRIDE_MM`]; the length is clamped to it.
+    pub const IMPLAUSIBLE: u8 = 1 << 7;
     /// Flags that make a length untrustworthy.
-    pub const INVALID: u8 = Self::SATURATED | Self::TOO_LONG;
+    pub const INVALID: u8 = Self::SATURATED | Self::TOO_LONG | Self::GAP | Self::IMPLAUSIBLE;
 
     /// True when no flag in [`StrideFlags::INVALID`] is set.
     pub const fn valid(self) -> bool {
@@ -116,6 +132,9 @@ enum State {
     Unprimed,
     Stance,
     Moving,
+    /// Samples were lost while a stride was (or may have been) in progress; waiting for the
+    /// next stance to close it as a [`StrideFlags::GAP`] stride.
+    Gap,
 }
 
 /// Turns stance decisions into strides, keeping at most `M` samples of a movement.
@@ -135,6 +154,14 @@ pub struct StrideTracker<const M: usize = MAX_MOVEMENT_SAMPLES> {
     merge_samples: u32,
     /// The last closed stride, held until the stance after it ends.
     pending: Option<Stride>,
+    /// First sample lost in the gap being bridged ([`State::Gap`]).
+    gap_at: u32,
+    /// Whether the foot was moving when the gap began.
+    gap_in_movement: bool,
+    /// Movement samples seen since the gap ended.
+    moving_after_gap: u32,
+    /// Number of the last sample fed, plus one.
+    fed_end: u32,
 }
 
 impl StrideTracker {
@@ -162,23 +189,97 @@ impl<const M: usize> StrideTracker<M> {
             phase_method,
             merge_samples: rate.samples_in_ms(phases::MERGE_MS),
             pending: None,
+            gap_at: 0,
+            gap_in_movement: false,
+            moving_after_gap: 0,
+            fed_end: 0,
         }
     }
 
-    /// Drops the movement in progress and waits for the next stance (after a gap); returns
-    /// the last stride closed before the gap, which is complete and was still held.
-    pub fn reset(&mut self) -> Option<Stride> {
-        self.state = State::Unprimed;
-        self.clear_stance();
+    /// Samples were lost after the last one fed (the samples the tracker has not seen count
+    /// as lost). The stride in progress (if the foot was moving) becomes a
+    /// [`StrideFlags::GAP`] stride, closed at the next stance; returns the last stride closed
+    /// before the gap, which is complete and was still held.
+    pub fn gap(&mut self) -> Option<Stride> {
+        let at = self.fed_end;
+        match self.state {
+            State::Unprimed | State::Gap => {}
+            State::Stance => {
+                self.state = State::Gap;
+                self.gap_at = at;
+                self.gap_in_movement = false;
+                self.heel_off = at;
+                self.moving_after_gap = 0;
+            }
+            State::Moving => {
+                self.state = State::Gap;
+                self.gap_at = at;
+                self.gap_in_movement = true;
+                self.moving_after_gap = 0;
+            }
+        }
         self.pending.take()
     }
 
-    /// Returns the stride still held at the end of a recording: the recording ended in the
-    /// stance after it, so it is the last before rest.
+    /// Holds `stride` again (see [`crate::pipeline::Pipeline::gap`]): it is reported with the
+    /// next one released. Only called with nothing held; a stride held already is kept.
+    pub fn hold(&mut self, stride: Stride) {
+        if self.pending.is_none() {
+            self.pending = Some(stride);
+        }
+    }
+
+    /// Returns a stride still held at the end of a recording, one per call: the stride
+    /// waiting for the stance after it (the recording ended in that stance, so it is the last
+    /// before rest), or else a gap stride still open, closed at the end.
     pub fn finish(&mut self) -> Option<Stride> {
-        let mut s = self.pending.take()?;
-        s.flags.0 |= StrideFlags::TO_REST;
-        Some(s)
+        if let Some(mut s) = self.pending.take() {
+            if self.state != State::Gap {
+                s.flags.0 |= StrideFlags::TO_REST;
+            }
+            return Some(s);
+        }
+        if self.state == State::Gap {
+            self.state = State::Unprimed;
+            if self.gap_stride_happened() {
+                return Some(self.close_gap(self.fed_end));
+            }
+        }
+        None
+    }
+
+    /// A stride went through the gap if the foot was moving when it began, or moved for at
+    /// least a step's minimum after it.
+    fn gap_stride_happened(&self) -> bool {
+        self.gap_in_movement || self.moving_after_gap >= self.min_movement
+    }
+
+    /// The [`StrideFlags::GAP`] stride from the stance before the gap to `end`.
+    #[inline(never)] // as `close`: off the per-sample frame
+    fn close_gap(&mut self, end: u32) -> Stride {
+        let max_start = self.heel_off.wrapping_sub(self.max_stance);
+        let stance = self.heel_off.wrapping_sub(self.stance_start);
+        let start = if stance > self.max_stance {
+            max_start
+        } else {
+            self.stance_start
+        };
+        let mut flags = StrideFlags::GAP;
+        if self.gap_in_movement {
+            flags |= self.flags & StrideFlags::SATURATED;
+        }
+        let index = self.next_index;
+        self.next_index = self.next_index.wrapping_add(1);
+        Stride {
+            index,
+            start,
+            heel_off: self.heel_off,
+            toe_off: self.gap_at,
+            heel_strike: self.gap_at,
+            end,
+            flags: StrideFlags(flags),
+            ..Stride::default()
+        }
     }
 
     fn clear_stance(&mut self) {
@@ -195,7 +296,21 @@ impl<const M: usize> StrideTracker<M> {
         foot: [i16; 3],
         stance: bool,
     ) -> Option<Stride> {
+        self.fed_end = index.wrapping_add(1);
         match (self.state, stance) {
+            (State::Gap, false) => {
+                self.moving_after_gap = self.moving_after_gap.saturating_add(1);
+                None
+            }
+            (State::Gap, true) => {
+                let stride = self.gap_stride_happened().then(|| self.close_gap(index));
+                self.state = State::Stance;
+                self.stance_start = index;
+                self.clear_stance();
+                self.accumulate_stance(s);
+                // Nothing is held in a gap ([`Self::gap`] handed it out), but never lose one.
+                stride.and_then(|st| self.pending.replace(st))
+            }
             (State::Unprimed, false) => None,
             (State::Unprimed, true) => {
                 self.state = State::Stance;

@@ -21,7 +21,9 @@
 use embedded_hal::delay::DelayNs;
 use embedded_hal::i2c::I2c;
 use gaitclip::mpu6050::{self, Mpu6050};
+use gaitclip::pipeline::Pipeline;
 use gaitclip::sample::RawSample;
+use gaitclip::stride::Stride;
 
 /// Immediate retries of a failed read.
 pub const RETRIES: u32 = 2;
@@ -36,9 +38,20 @@ pub const FIFO_BURST: usize = 16;
 pub enum Item {
     /// One sample, in order.
     Sample(RawSample),
-    /// This many sample periods were lost here: the pipeline drops the stride in progress
-    /// instead of measuring across the hole.
+    /// This many sample periods were lost here: the pipeline reports the stride in progress
+    /// as a gap stride (invalid, no length) instead of measuring across the hole.
     Gap(u32),
+}
+
+impl Item {
+    /// Hands the item to the pipeline; the stride it lets the pipeline report, if any (a
+    /// gap's was closed before the gap).
+    pub fn feed<const M: usize>(self, pipeline: &mut Pipeline<M>) -> Option<Stride> {
+        match self {
+            Item::Sample(s) => pipeline.process(&s),
+            Item::Gap(n) => pipeline.gap(n),
+        }
+    }
 }
 
 /// How the sensor is read.

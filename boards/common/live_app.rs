@@ -190,27 +190,24 @@ pub fn main_loop<const M: usize>(
     let mut next_status = status_every_samples;
     loop {
         while let Some(item) = consumer.dequeue() {
+            let stride = item.feed(pipeline);
+            if let Item::Sample(_) = item {
+                samples = samples.wrapping_add(1);
+                if let Some(e) = startup.update(pipeline) {
+                    log.startup(e, serial);
+                }
+            }
+            // A stride a gap hands back was closed before it: it comes first.
+            if let Some(stride) = &stride {
+                log.stride(stride, serial);
+            }
             match item {
-                Item::Sample(s) => {
-                    samples = samples.wrapping_add(1);
-                    let stride = pipeline.process(&s);
-                    if let Some(e) = startup.update(pipeline) {
-                        log.startup(e, serial);
-                    }
-                    if let Some(stride) = stride {
-                        log.stride(&stride, serial);
-                    }
-                    if samples == next_status {
-                        next_status = next_status.wrapping_add(status_every_samples);
-                        log.summary(samples, &counters(), serial);
-                    }
+                Item::Sample(_) if samples == next_status => {
+                    next_status = next_status.wrapping_add(status_every_samples);
+                    log.summary(samples, &counters(), serial);
                 }
-                Item::Gap(n) => {
-                    log.gap(n, serial);
-                    if let Some(stride) = pipeline.gap(n) {
-                        log.stride(&stride, serial);
-                    }
-                }
+                Item::Sample(_) => {}
+                Item::Gap(n) => log.gap(n, serial),
             }
         }
         // Interrupts are masked while checking the queue so that a sample arriving between

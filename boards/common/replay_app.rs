@@ -167,23 +167,22 @@ fn handle<const M: usize>(
     samples: &mut u32,
 ) {
     let serial = &mut NoSerial;
+    let stride = item.feed(pipeline);
     match item {
-        Item::Sample(s) => {
+        Item::Sample(_) => {
             *samples = samples.wrapping_add(1);
-            let stride = pipeline.process(&s);
             if let Some(e) = startup.update(pipeline) {
                 log.startup(e, serial);
             }
-            if let Some(stride) = stride {
-                log.stride(&stride, serial);
-            }
         }
-        Item::Gap(n) => {
-            log.gap(n, serial);
-            if let Some(stride) = pipeline.gap(n) {
-                log.stride(&stride, serial);
-            }
-        }
+        Item::Gap(_) => {}
+    }
+    // A stride a gap hands back was closed before it: it comes first.
+    if let Some(stride) = &stride {
+        log.stride(stride, serial);
+    }
+    if let Item::Gap(n) = item {
+        log.gap(n, serial);
     }
 }
 

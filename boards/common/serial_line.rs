@@ -17,8 +17,9 @@
 //! `index` counts strides from 0; `t_ms` is the start of the stride since power-up;
 //! `duration_ms` is the whole stride and the four phase columns add up to it; `flags` is
 //! the bit set of [`gaitclip::stride::StrideFlags`] (1 saturated, 2 too long, 4 from rest,
-//! 8 to rest, 16 turn, 32 phases guessed); `valid` is 0 when a flag makes the length
-//! untrustworthy. `tests-host/tests/serial_line.rs` parses these lines back.
+//! 8 to rest, 16 turn, 32 phases guessed, 64 gap, 128 implausible); `valid` is 0 when a flag
+//! makes the length untrustworthy (a gap stride has length 0).
+//! `tests-host/tests/board_glue.rs` parses these lines back.
 
 use core::fmt::{self, Write};
 
