@@ -61,6 +61,20 @@ impl From<&gaitclip::stride::Stride> for Detected {
     }
 }
 
+impl Detected {
+    /// The stride with every event index mapped by `f` (core sample numbers to recording
+    /// indices across gaps).
+    pub fn map(self, f: impl Fn(u32) -> u32) -> Self {
+        Detected {
+            start: f(self.start),
+            heel_off: f(self.heel_off),
+            toe_off: f(self.toe_off),
+            heel_strike: f(self.heel_strike),
+            end: f(self.end),
+        }
+    }
+}
+
 /// One reference stride.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Reference {

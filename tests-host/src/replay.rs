@@ -11,6 +11,7 @@ use gaitclip::sample::RawSample;
 use gaitclip::stride::{Stride, StrideFlags};
 use serde::Serialize;
 
+use crate::gaps::{self, Gap, GapClock};
 use crate::trace::{Ranges, Trace};
 
 /// Why a trace cannot be replayed.
@@ -19,6 +20,9 @@ pub enum ReplayError {
     /// The rate is outside what the core supports.
     #[error("sample rate {0} Hz is outside 100–1000 Hz")]
     Rate(f64),
+    /// The timestamps go backwards or repeat.
+    #[error(transparent)]
+    Time(#[from] crate::gaps::TimeError),
 }
 
 /// A stride as the host reports it.
@@ -79,6 +83,12 @@ pub fn flag_names(f: StrideFlags) -> Vec<&'static str> {
     if f.has(StrideFlags::PHASES_GUESSED) {
         v.push("phases_guessed");
     }
+    if f.has(StrideFlags::GAP) {
+        v.push("gap");
+    }
+    if f.has(StrideFlags::IMPLAUSIBLE) {
+        v.push("implausible");
+    }
     v
 }
 
@@ -94,12 +104,39 @@ pub fn replay_counts(
     replay_counts_with(samples, config, t_s)
 }
 
-/// The core's strides for raw counts, in the order it reports them.
+/// The core's strides for raw counts without gaps, in the order it reports them.
 pub fn core_strides(samples: &[RawSample], config: Config) -> Vec<Stride> {
+    core_strides_gapped(samples, &[], config)
+}
+
+/// The core's strides for raw counts with `gaps` (sorted by position) declared to it as
+/// the firmware declares a FIFO overflow.
+pub fn core_strides_gapped(samples: &[RawSample], gaps: &[Gap], config: Config) -> Vec<Stride> {
     let mut p = Pipeline::new(config);
-    let mut strides: Vec<Stride> = samples.iter().filter_map(|s| p.process(s)).collect();
+    let mut strides = Vec::new();
+    let mut next_gap = gaps.iter().peekable();
+    for (i, s) in samples.iter().enumerate() {
+        while let Some(g) = next_gap.next_if(|g| g.before <= i) {
+            strides.extend(p.gap(g.missing));
+        }
+        strides.extend(p.process(s));
+    }
     strides.extend(p.finish().into_iter().flatten());
     strides
+}
+
+/// The raw counts of a trace at `ranges`, the gaps in its timestamps and the sample rate,
+/// ready for [`core_strides_gapped`].
+pub fn prepare(
+    trace: &Trace,
+    ranges: Ranges,
+) -> Result<(Vec<RawSample>, Vec<Gap>, SampleRate), ReplayError> {
+    let rate = trace
+        .sample_rate()
+        .ok_or(ReplayError::Rate(trace.rate_hz))?;
+    let gaps = gaps::find(&trace.samples, trace.rate_hz)?;
+    let counts = trace.samples.iter().map(|s| ranges.to_counts(s)).collect();
+    Ok((counts, gaps, rate))
 }
 
 /// Replays raw counts through the core configured by `config`.
@@ -127,22 +164,20 @@ pub fn replay_model(
     model: Model,
     all_models: bool,
 ) -> Result<Vec<StrideReport>, ReplayError> {
-    let rate = trace
-        .sample_rate()
-        .ok_or(ReplayError::Rate(trace.rate_hz))?;
-    let counts: Vec<RawSample> = trace.samples.iter().map(|s| ranges.to_counts(s)).collect();
-    let times: Vec<f64> = trace.samples.iter().map(|s| s.t_s).collect();
-    let dt = 1.0 / trace.rate_hz;
-    let t_s = |i: u32| match times.get(i as usize) {
-        Some(&t) => t,
-        // Past the end (cannot happen for events, which lie on fed samples): extrapolate.
-        None => times.last().copied().unwrap_or(0.0) + dt * (i as f64 - times.len() as f64 + 1.0),
-    };
+    let (counts, gaps, rate) = prepare(trace, ranges)?;
+    let clock = GapClock::new(&trace.samples, &gaps, trace.rate_hz);
     let mut config = Config::new(rate, ranges.accel, ranges.gyro);
     config.model = model;
-    let mut out = replay_counts_with(&counts, config, t_s);
+    let mut out: Vec<StrideReport> = core_strides_gapped(&counts, &gaps, config)
+        .into_iter()
+        .map(|s| report(s, config.model, &|n| clock.t_s(n)))
+        .collect();
     if all_models {
         for r in &mut out {
+            if r.raw.flags.has(StrideFlags::GAP) {
+                // No length across a gap, from any model.
+                continue;
+            }
             let f = Features::of(&r.raw, rate);
             r.lengths_m = Some(
                 Model::ALL

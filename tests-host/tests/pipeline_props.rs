@@ -1,9 +1,10 @@
 //! Property tests of the core on arbitrary input: never a panic (overflow checks are on in
-//! tests), and every stride well formed.
+//! tests), state bounded by its constants, and every stride well formed.
 
 use gaitclip::pipeline::{Config, Pipeline};
 use gaitclip::rate::SampleRate;
 use gaitclip::sample::{AccelRange, GyroRange, RawSample};
+use gaitclip::stride::{Stride, StrideFlags, MAX_STRIDE_MM};
 use proptest::prelude::*;
 
 fn sample() -> impl Strategy<Value = RawSample> {
@@ -37,33 +38,56 @@ fn runs() -> impl Strategy<Value = Vec<RawSample>> {
     })
 }
 
-fn check(samples: &[RawSample], rate_hz: u32, gaps: &[usize]) {
-    let mut p = Pipeline::new(Config::new(
-        SampleRate::from_hz(rate_hz).unwrap(),
-        AccelRange::G16,
-        GyroRange::Dps2000,
-    ));
+/// The demo walk's counts (200 Hz, ±16 g, ±2000 °/s): real strides to cut gaps into.
+fn walk() -> Vec<RawSample> {
+    gaitclip_host::fixtures::firmware_trace_counts().unwrap()
+}
+
+/// Feeds `samples` with a gap of `missing` before each index in `gaps`; checks every stride
+/// and returns them.
+fn check<const M: usize>(
+    samples: &[RawSample],
+    rate_hz: u32,
+    gaps: &[(usize, u32)],
+) -> Vec<Stride> {
+    let rate = SampleRate::from_hz(rate_hz).unwrap();
+    let mut p = Pipeline::<M>::sized(Config::new(rate, AccelRange::G16, GyroRange::Dps2000));
     let mut strides = Vec::new();
     for (i, s) in samples.iter().enumerate() {
-        if gaps.contains(&i) {
-            strides.extend(p.gap(7));
+        for &(_, missing) in gaps.iter().filter(|g| g.0 == i) {
+            strides.extend(p.gap(missing));
         }
         strides.extend(p.process(s));
     }
     strides.extend(p.finish().into_iter().flatten());
+    let buffer_ms = M as u64 * 1000 / rate_hz as u64;
     for (k, s) in strides.iter().enumerate() {
         assert!(s.start <= s.heel_off && s.heel_off <= s.toe_off, "{s:?}");
-        assert!(s.toe_off <= s.heel_strike && s.heel_strike < s.end, "{s:?}");
+        assert!(s.toe_off <= s.heel_strike && s.heel_strike <= s.end, "{s:?}");
+        assert!(s.start < s.end, "{s:?}");
+        // A gap stride's events after the gap are unknown (set to the gap, which may be its
+        // end when the recording stops in it); every other stride ends after heel-strike.
+        assert!(s.heel_strike < s.end || s.flags.has(StrideFlags::GAP), "{s:?}");
         assert!(s.end <= p.next_index(), "{s:?}");
+        assert!(s.length_mm <= MAX_STRIDE_MM, "{s:?}");
+        if s.flags.has(StrideFlags::GAP) {
+            assert_eq!(s.length_mm, 0, "no length across a gap: {s:?}");
+            assert!(!s.flags.valid());
+        }
+        // The movement buffer holds M samples; a longer movement is flagged, not grown.
+        let moved_ms = (s.end - s.heel_off) as u64 * 1000 / rate_hz as u64;
+        if moved_ms > buffer_ms + 1 && !s.flags.has(StrideFlags::GAP) {
+            assert!(s.flags.has(StrideFlags::TOO_LONG), "{s:?}");
+        }
         if k > 0 {
             assert!(s.index == strides[k - 1].index + 1);
             assert!(
-                s.start >= strides[k - 1].end
-                    || s.flags.has(gaitclip::stride::StrideFlags::FROM_REST),
+                s.start >= strides[k - 1].end || s.flags.has(StrideFlags::FROM_REST),
                 "{s:?}"
             );
         }
     }
+    strides
 }
 
 proptest! {
@@ -71,11 +95,47 @@ proptest! {
 
     #[test]
     fn arbitrary_samples_never_panic(samples in prop::collection::vec(sample(), 0..3000), rate in 100u32..=1000) {
-        check(&samples, rate, &[]);
+        check::<1024>(&samples, rate, &[]);
     }
 
     #[test]
-    fn runs_and_gaps_never_panic(samples in runs(), rate in 100u32..=1000, gaps in prop::collection::vec(0usize..5000, 0..5)) {
-        check(&samples, rate, &gaps);
+    fn runs_and_gaps_never_panic(samples in runs(), rate in 100u32..=1000, gaps in prop::collection::vec((0usize..5000, 0u32..100_000), 0..5)) {
+        check::<1024>(&samples, rate, &gaps);
+    }
+
+    #[test]
+    fn a_small_movement_buffer_flags_instead_of_growing(samples in runs(), rate in 100u32..=1000) {
+        check::<32>(&samples, rate, &[]);
+    }
+
+    /// A gap cut anywhere into a real walk: every stride the gap does not touch is the same
+    /// as without it, and the strides it touches are reported once, flagged, without a length.
+    #[test]
+    fn a_gap_in_a_walk_costs_only_the_stride_it_falls_in(at in 0usize..6000, missing in 1u32..400) {
+        let mut counts = walk();
+        let whole = check::<1024>(&counts, 200, &[]);
+        let at = at.min(counts.len() - 1);
+        let lost = missing as usize;
+        counts.drain(at..(at + lost).min(counts.len()));
+        let cut = check::<1024>(&counts, 200, &[(at, missing)]);
+        // A stride wholly before the gap (and its following stance ending before it too)
+        // is untouched; so is one wholly after the gap, once detection has restarted.
+        let gap_end = at as u32 + missing;
+        for w in &whole {
+            let before = w.end + 200 < at as u32;
+            if before {
+                let c = cut.iter().find(|c| c.start == w.start).unwrap_or_else(|| panic!("{w:?} lost"));
+                prop_assert_eq!(c.length_mm, w.length_mm);
+                prop_assert_eq!(c.flags, w.flags);
+            }
+        }
+        // No stride with a length spans the gap.
+        for c in &cut {
+            if c.start < at as u32 && c.end > at as u32 {
+                prop_assert!(c.flags.has(StrideFlags::GAP), "{:?} spans the gap at {}..{}", c, at, gap_end);
+            }
+        }
+        let gap_strides = cut.iter().filter(|c| c.flags.has(StrideFlags::GAP)).count();
+        prop_assert!(gap_strides <= 1, "{:?}", cut);
     }
 }

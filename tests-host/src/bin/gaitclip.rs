@@ -196,15 +196,13 @@ fn run(cli: Cli) -> anyhow::Result<()> {
             plots,
         } => {
             let detector = |t: &Trace, r: Ranges| -> anyhow::Result<Vec<Detected>> {
-                let rate = t
-                    .sample_rate()
-                    .ok_or(replay::ReplayError::Rate(t.rate_hz))?;
+                let (counts, gaps, rate) = replay::prepare(t, r)?;
                 let mut config = Config::new(rate, r.accel, r.gyro);
                 config.phases = phases.into();
-                let counts: Vec<_> = t.samples.iter().map(|s| r.to_counts(s)).collect();
-                Ok(replay::core_strides(&counts, config)
+                let clock = gaitclip_host::gaps::GapClock::new(&t.samples, &gaps, t.rate_hz);
+                Ok(replay::core_strides_gapped(&counts, &gaps, config)
                     .iter()
-                    .map(Detected::from)
+                    .map(|s| Detected::from(s).map(|n| clock.recording_index(n)))
                     .collect())
             };
             let mut results = Vec::new();
