@@ -46,6 +46,22 @@ pub enum CsvError {
         /// The cell text.
         text: String,
     },
+    /// A timestamp is not later than the one on the line before.
+    #[error(
+        "{path}:{line}:{col}: column `t_s`: {t_s} is not after the previous line's {previous_s}"
+    )]
+    TimeNotIncreasing {
+        /// The file.
+        path: PathBuf,
+        /// 1-based line number.
+        line: u64,
+        /// 1-based column number of `t_s`.
+        col: usize,
+        /// The time on this line, s.
+        t_s: f64,
+        /// The time on the line before, s.
+        previous_s: f64,
+    },
     /// A row is structurally broken (wrong field count, bad UTF-8 …).
     #[error("{path}:{line}: {message}")]
     Malformed {
@@ -160,6 +176,17 @@ pub fn parse(path: &Path, bytes: &[u8]) -> Result<Vec<ImuSample>, CsvError> {
                     column: name,
                     text: text.to_owned(),
                 })?;
+        }
+        if let Some(prev) = out.last().map(|p: &ImuSample| p.t_s) {
+            if v[0] <= prev {
+                return Err(CsvError::TimeNotIncreasing {
+                    path: path.to_owned(),
+                    line,
+                    col: idx[0] + 1,
+                    t_s: v[0],
+                    previous_s: prev,
+                });
+            }
         }
         out.push(ImuSample {
             t_s: v[0],

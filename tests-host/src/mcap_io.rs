@@ -52,6 +52,16 @@ pub enum McapError {
         /// The parser's error.
         source: mcap::McapError,
     },
+    /// The file is a git-LFS pointer: the recording itself was never fetched.
+    #[error("{path}: a git-LFS pointer ({size} bytes of MCAP not fetched, {oid}), not an MCAP file: run `git lfs pull` in the repository it came from")]
+    LfsPointer {
+        /// The file.
+        path: PathBuf,
+        /// The object id the pointer names.
+        oid: String,
+        /// Size of the real file, bytes, as the pointer says.
+        size: String,
+    },
     /// No channel carries IMU samples.
     #[error("{path}: no IMU channel (schema `{IMU_SCHEMA}` or `{ROS2_IMU_SCHEMA}` with CDR); channels seen: {seen}")]
     NoImuChannel {
@@ -83,74 +93,200 @@ enum ImuKind {
     Ros2Cdr,
 }
 
-fn imu_kind(ch: &mcap::Channel<'_>) -> Option<ImuKind> {
-    let schema = ch.schema.as_ref()?;
-    match (schema.name.as_str(), ch.message_encoding.as_str()) {
+fn imu_kind(schema: &str, message_encoding: &str) -> Option<ImuKind> {
+    match (schema, message_encoding) {
         (IMU_SCHEMA, "json") => Some(ImuKind::Json),
         (ROS2_IMU_SCHEMA, "cdr") => Some(ImuKind::Ros2Cdr),
         _ => None,
     }
 }
 
-/// Reads the IMU samples of the first IMU channel (by channel id) of an MCAP file. The rate
-/// is `rate_hz` if given, else the median interval of the timestamps.
+/// A schema, channel or message record as a streamed reader sees it (chunks opened, the
+/// summary section included): what the MCAP conformance files list.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub enum McapRecord {
+    /// A schema.
+    Schema {
+        /// Schema id.
+        id: u16,
+        /// Name.
+        name: String,
+        /// Encoding of the schema data.
+        encoding: String,
+        /// The schema itself.
+        data: Vec<u8>,
+    },
+    /// A channel.
+    Channel {
+        /// Channel id.
+        id: u16,
+        /// Its schema (0: none).
+        schema_id: u16,
+        /// Topic.
+        topic: String,
+        /// Encoding of its messages.
+        message_encoding: String,
+        /// User metadata.
+        metadata: BTreeMap<String, String>,
+    },
+    /// A message.
+    Message {
+        /// Its channel.
+        channel_id: u16,
+        /// Sequence number.
+        sequence: u32,
+        /// Log time, ns.
+        log_time: u64,
+        /// Publish time, ns.
+        publish_time: u64,
+        /// Payload.
+        data: Vec<u8>,
+    },
+}
+
+/// Reads every schema, channel and message record of an MCAP file's bytes, in file order;
+/// `path` is only for error messages.
+pub fn read_records(path: &Path, bytes: &[u8]) -> Result<Vec<McapRecord>, McapError> {
+    const LFS: &[u8] = b"version https://git-lfs.github.com/spec/v1\n";
+    if let Some(rest) = bytes.strip_prefix(LFS) {
+        let text = String::from_utf8_lossy(rest);
+        let field = |k: &str| {
+            text.lines()
+                .find_map(|l| l.strip_prefix(k))
+                .unwrap_or("?")
+                .trim()
+                .to_owned()
+        };
+        return Err(McapError::LfsPointer {
+            path: path.to_owned(),
+            oid: field("oid "),
+            size: field("size "),
+        });
+    }
+    let fmt = |source| McapError::Format {
+        path: path.to_owned(),
+        source,
+    };
+    let mut out = Vec::new();
+    for r in mcap::read::ChunkFlattener::new(bytes).map_err(fmt)? {
+        match r.map_err(fmt)? {
+            mcap::records::Record::Schema { header, data } => out.push(McapRecord::Schema {
+                id: header.id,
+                name: header.name,
+                encoding: header.encoding,
+                data: data.into_owned(),
+            }),
+            mcap::records::Record::Channel(c) => out.push(McapRecord::Channel {
+                id: c.id,
+                schema_id: c.schema_id,
+                topic: c.topic,
+                message_encoding: c.message_encoding,
+                metadata: c.metadata,
+            }),
+            mcap::records::Record::Message { header, data } => out.push(McapRecord::Message {
+                channel_id: header.channel_id,
+                sequence: header.sequence,
+                log_time: header.log_time,
+                publish_time: header.publish_time,
+                data: data.into_owned(),
+            }),
+            _ => {}
+        }
+    }
+    Ok(out)
+}
+
+/// Reads the IMU samples of the first IMU channel (the first to carry a message) of an
+/// MCAP file. The rate is `rate_hz` if given, else the median interval of the timestamps.
 pub fn read(path: &Path, rate_hz: Option<f64>) -> Result<Trace, McapError> {
     let bytes = fs::read(path).map_err(|source| McapError::Io {
         path: path.to_owned(),
         source,
     })?;
-    let fmt = |source| McapError::Format {
-        path: path.to_owned(),
-        source,
-    };
-    let mut channels: BTreeMap<u16, (String, String, String)> = BTreeMap::new();
+    decode(path, &bytes, rate_hz)
+}
+
+/// [`read`] on bytes already in memory; `path` is only for error messages.
+pub fn decode(path: &Path, bytes: &[u8], rate_hz: Option<f64>) -> Result<Trace, McapError> {
+    let records = read_records(path, bytes)?;
+    // (schema name, encoding) by schema id; (topic, schema id, encoding) by channel id.
+    let mut schemas: BTreeMap<u16, &str> = BTreeMap::new();
+    let mut channels: BTreeMap<u16, (&str, u16, &str)> = BTreeMap::new();
     let mut chosen: Option<(u16, ImuKind)> = None;
-    let mut samples = Vec::new();
-    for msg in mcap::MessageStream::new(&bytes).map_err(fmt)? {
-        let msg = msg.map_err(fmt)?;
-        let ch = &msg.channel;
-        channels.entry(ch.id).or_insert_with(|| {
-            let schema = ch
-                .schema
-                .as_ref()
-                .map_or("no schema".to_owned(), |s| s.name.clone());
-            (ch.topic.clone(), schema, ch.message_encoding.clone())
-        });
-        if chosen.is_none() {
-            chosen = imu_kind(ch).map(|k| (ch.id, k));
-        }
-        let Some((id, kind)) = chosen else { continue };
-        if ch.id != id {
-            continue;
-        }
-        let bad = |message: String| McapError::BadMessage {
-            path: path.to_owned(),
-            index: samples.len(),
-            topic: ch.topic.clone(),
-            message,
-        };
-        let s = match kind {
-            ImuKind::Json => {
-                let j: ImuJson =
-                    serde_json::from_slice(&msg.data).map_err(|e| bad(e.to_string()))?;
-                ImuSample {
-                    t_s: j.t_s,
-                    acc_mps2: j.acc,
-                    gyr_radps: j.gyr,
-                }
+    let mut samples: Vec<ImuSample> = Vec::new();
+    for r in &records {
+        match r {
+            McapRecord::Schema { id, name, .. } => {
+                schemas.entry(*id).or_insert(name);
             }
-            ImuKind::Ros2Cdr => {
-                let mut s = decode_ros2_imu(&msg.data).map_err(bad)?;
-                if s.t_s == 0.0 {
-                    s.t_s = msg.log_time as f64 * 1e-9;
-                }
-                s
+            McapRecord::Channel {
+                id,
+                schema_id,
+                topic,
+                message_encoding,
+                ..
+            } => {
+                channels
+                    .entry(*id)
+                    .or_insert((topic, *schema_id, message_encoding));
             }
-        };
-        if !(s.t_s.is_finite() && s.acc_mps2.iter().chain(&s.gyr_radps).all(|v| v.is_finite())) {
-            return Err(bad("non-finite value".into()));
+            McapRecord::Message {
+                channel_id,
+                log_time,
+                data,
+                ..
+            } => {
+                let Some(&(topic, schema_id, encoding)) = channels.get(channel_id) else {
+                    continue;
+                };
+                if chosen.is_none() {
+                    let schema = schemas.get(&schema_id).copied().unwrap_or("");
+                    chosen = imu_kind(schema, encoding).map(|k| (*channel_id, k));
+                }
+                let Some((id, kind)) = chosen else { continue };
+                if *channel_id != id {
+                    continue;
+                }
+                let bad = |message: String| McapError::BadMessage {
+                    path: path.to_owned(),
+                    index: samples.len(),
+                    topic: topic.to_owned(),
+                    message,
+                };
+                let s = match kind {
+                    ImuKind::Json => {
+                        let j: ImuJson =
+                            serde_json::from_slice(data).map_err(|e| bad(e.to_string()))?;
+                        ImuSample {
+                            t_s: j.t_s,
+                            acc_mps2: j.acc,
+                            gyr_radps: j.gyr,
+                        }
+                    }
+                    ImuKind::Ros2Cdr => {
+                        let mut s = decode_ros2_imu(data).map_err(bad)?;
+                        if s.t_s == 0.0 {
+                            s.t_s = *log_time as f64 * 1e-9;
+                        }
+                        s
+                    }
+                };
+                if !(s.t_s.is_finite()
+                    && s.acc_mps2.iter().chain(&s.gyr_radps).all(|v| v.is_finite()))
+                {
+                    return Err(bad("non-finite value".into()));
+                }
+                if let Some(prev) = samples.last() {
+                    if s.t_s <= prev.t_s {
+                        return Err(bad(format!(
+                            "time {} s is not after the previous message's {} s",
+                            s.t_s, prev.t_s
+                        )));
+                    }
+                }
+                samples.push(s);
+            }
         }
-        samples.push(s);
     }
     if samples.is_empty() {
         let seen = if channels.is_empty() {
@@ -158,7 +294,10 @@ pub fn read(path: &Path, rate_hz: Option<f64>) -> Result<Trace, McapError> {
         } else {
             channels
                 .values()
-                .map(|(t, s, e)| format!("{t} ({s}, {e})"))
+                .map(|&(t, sid, e)| {
+                    let s = schemas.get(&sid).copied().unwrap_or("no schema");
+                    format!("{t} ({s}, {e})")
+                })
                 .collect::<Vec<_>>()
                 .join(", ")
         };

@@ -62,3 +62,13 @@ fn header_only_is_empty() {
     let e = parse(Path::new("w.csv"), HEADER.as_bytes()).unwrap_err();
     assert_eq!(e.to_string(), "w.csv: no samples");
 }
+
+#[test]
+fn time_going_back_names_line_and_column() {
+    let text = "acc_x,t_s,acc_y,acc_z,gyr_x,gyr_y,gyr_z\n1,0.010,2,3,4,5,6\n1,0.015,2,3,4,5,6\n1,0.015,2,3,4,5,6\n";
+    let e = parse(Path::new("w.csv"), text.as_bytes()).unwrap_err();
+    assert_eq!(
+        e.to_string(),
+        "w.csv:4:2: column `t_s`: 0.015 is not after the previous line's 0.015"
+    );
+}

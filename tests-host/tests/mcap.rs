@@ -137,9 +137,30 @@ fn mcap_without_imu_lists_the_channels_it_saw() {
 #[test]
 fn not_an_mcap_is_a_clear_error() {
     let path = tmp("bad.mcap");
-    std::fs::write(&path, b"version https://git-lfs.github.com/spec/v1\n").unwrap();
+    std::fs::write(&path, b"t_s,acc_x\n0,1\n").unwrap();
     let msg = mcap_io::read(&path, None).unwrap_err().to_string();
     assert!(msg.contains("not a readable MCAP file"), "{msg}");
     assert!(msg.contains("bad.mcap"), "{msg}");
+    let _ = std::fs::remove_file(path);
+}
+
+#[test]
+fn a_git_lfs_pointer_says_so() {
+    let path = tmp("pointer.mcap");
+    std::fs::write(
+        &path,
+        b"version https://git-lfs.github.com/spec/v1\noid sha256:45cb\nsize 362\n",
+    )
+    .unwrap();
+    let e = mcap_io::read(&path, None).unwrap_err();
+    assert!(matches!(e, McapError::LfsPointer { .. }), "{e:?}");
+    let msg = e.to_string();
+    assert!(
+        msg.contains(
+            "pointer.mcap: a git-LFS pointer (362 bytes of MCAP not fetched, sha256:45cb)"
+        ),
+        "{msg}"
+    );
+    assert!(msg.contains("git lfs pull"), "{msg}");
     let _ = std::fs::remove_file(path);
 }
