@@ -63,11 +63,17 @@ fn check<const M: usize>(
     let buffer_ms = M as u64 * 1000 / rate_hz as u64;
     for (k, s) in strides.iter().enumerate() {
         assert!(s.start <= s.heel_off && s.heel_off <= s.toe_off, "{s:?}");
-        assert!(s.toe_off <= s.heel_strike && s.heel_strike <= s.end, "{s:?}");
+        assert!(
+            s.toe_off <= s.heel_strike && s.heel_strike <= s.end,
+            "{s:?}"
+        );
         assert!(s.start < s.end, "{s:?}");
         // A gap stride's events after the gap are unknown (set to the gap, which may be its
         // end when the recording stops in it); every other stride ends after heel-strike.
-        assert!(s.heel_strike < s.end || s.flags.has(StrideFlags::GAP), "{s:?}");
+        assert!(
+            s.heel_strike < s.end || s.flags.has(StrideFlags::GAP),
+            "{s:?}"
+        );
         assert!(s.end <= p.next_index(), "{s:?}");
         assert!(s.length_mm <= MAX_STRIDE_MM, "{s:?}");
         if s.flags.has(StrideFlags::GAP) {

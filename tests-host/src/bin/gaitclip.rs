@@ -121,13 +121,70 @@ fn model_names() -> clap::builder::PossibleValuesParser {
     clap::builder::PossibleValuesParser::new(Model::ALL.map(|m| m.name()))
 }
 
+/// Exit statuses, from BSD's sysexits so that scripts can tell bad input from a bug. A
+/// command line clap cannot parse exits with 2; a panic (a bug) with Rust's 101.
+mod status {
+    /// The input is malformed: a CSV cell, a column, an MCAP record, timestamps.
+    pub const BAD_INPUT: u8 = 65;
+    /// An input file cannot be opened or read.
+    pub const NO_INPUT: u8 = 66;
+    /// Anything else: gaitclip's own fault.
+    pub const INTERNAL: u8 = 70;
+    /// An output file cannot be written.
+    pub const CANT_WRITE: u8 = 74;
+}
+
+/// Creating or writing an output file failed.
+#[derive(Debug, thiserror::Error)]
+#[error("{path}: {source}")]
+struct WriteError {
+    path: PathBuf,
+    source: std::io::Error,
+}
+
+/// The exit status for an error: by the first typed cause in its chain.
+fn status_of(e: &anyhow::Error) -> u8 {
+    use gaitclip_host::csv_trace::CsvError;
+    use gaitclip_host::gaps::TimeError;
+    use gaitclip_host::mcap_io::McapError;
+    for cause in e.chain() {
+        if let Some(c) = cause.downcast_ref::<CsvError>() {
+            return match c {
+                CsvError::Io { .. } => status::NO_INPUT,
+                _ => status::BAD_INPUT,
+            };
+        }
+        if let Some(m) = cause.downcast_ref::<McapError>() {
+            return match m {
+                McapError::Io { .. } => status::NO_INPUT,
+                McapError::Write(_) => status::CANT_WRITE,
+                _ => status::BAD_INPUT,
+            };
+        }
+        if cause.is::<replay::ReplayError>() || cause.is::<TimeError>() {
+            return status::BAD_INPUT;
+        }
+        if cause.is::<WriteError>() {
+            return status::CANT_WRITE;
+        }
+    }
+    status::INTERNAL
+}
+
 fn main() -> ExitCode {
     let cli = Cli::parse();
     match run(cli) {
         Ok(()) => ExitCode::SUCCESS,
         Err(e) => {
-            eprintln!("gaitclip: {e:#}");
-            ExitCode::from(2)
+            let status = status_of(&e);
+            let kind = match status {
+                status::BAD_INPUT => "bad input",
+                status::NO_INPUT => "cannot read input",
+                status::CANT_WRITE => "cannot write output",
+                _ => "internal error",
+            };
+            eprintln!("gaitclip: {kind}: {e:#}");
+            ExitCode::from(status)
         }
     }
 }
@@ -155,7 +212,8 @@ fn run(cli: Cli) -> anyhow::Result<()> {
         } => {
             let t = read_trace(&trace, rate)?;
             let model = Model::from_name(&model).context("unknown model")?;
-            let strides = replay::replay_model(&t, Ranges::default(), model, all_models)?;
+            let strides = replay::replay_model(&t, Ranges::default(), model, all_models)
+                .with_context(|| trace.display().to_string())?;
             for s in &strides {
                 if json {
                     println!("{}", serde_json::to_string(s)?);
@@ -182,8 +240,10 @@ fn run(cli: Cli) -> anyhow::Result<()> {
             let total: f64 = strides.iter().map(|s| s.length_m).sum();
             eprintln!("{} strides, {:.3} m in total", strides.len(), total);
             if let Some(out) = mcap_out {
-                let f = std::fs::File::create(&out)
-                    .with_context(|| format!("creating {}", out.display()))?;
+                let f = std::fs::File::create(&out).map_err(|source| WriteError {
+                    path: out.clone(),
+                    source,
+                })?;
                 mcap_io::write(std::io::BufWriter::new(f), &t.samples, &strides)?;
                 eprintln!("wrote {}", out.display());
             }

@@ -1,0 +1,116 @@
+//! What a user sees when an input is wrong: the `gaitclip` command names the file, line and
+//! column or the channels it saw, and its exit status tells bad input (65), an unreadable
+//! file (66) and an unwritable output (74) from internal errors (70).
+
+use std::path::PathBuf;
+use std::process::Command;
+
+fn gaitclip(args: &[&str]) -> (Option<i32>, String) {
+    let out = Command::new(env!("CARGO_BIN_EXE_gaitclip"))
+        .args(args)
+        .output()
+        .unwrap();
+    (
+        out.status.code(),
+        String::from_utf8_lossy(&out.stderr).into_owned(),
+    )
+}
+
+fn tmp(name: &str, bytes: &[u8]) -> PathBuf {
+    let p = std::env::temp_dir().join(format!("gaitclip-cli-{}-{name}", std::process::id()));
+    std::fs::write(&p, bytes).unwrap();
+    p
+}
+
+const HEADER: &str = "t_s,acc_x,acc_y,acc_z,gyr_x,gyr_y,gyr_z\n";
+
+#[test]
+fn a_malformed_csv_cell_is_bad_input_named_by_line_and_column() {
+    let p = tmp(
+        "cell.csv",
+        format!("{HEADER}0,0,0,9.8,0,0,0\n0.005,0,0,9.8,0,x,0\n").as_bytes(),
+    );
+    let (code, err) = gaitclip(&["replay", p.to_str().unwrap(), "--rate", "200"]);
+    assert_eq!(code, Some(65), "{err}");
+    assert!(err.contains("bad input"), "{err}");
+    assert!(
+        err.contains(&format!("{}:3:6: column `gyr_y`: `x`", p.display())),
+        "{err}"
+    );
+    let _ = std::fs::remove_file(p);
+}
+
+#[test]
+fn a_missing_column_is_bad_input_and_named() {
+    let p = tmp(
+        "col.csv",
+        b"t_s,acc_x,acc_y,acc_z,gyr_x,gyr_z\n0,0,0,9.8,0,0\n",
+    );
+    let (code, err) = gaitclip(&["replay", p.to_str().unwrap()]);
+    assert_eq!(code, Some(65), "{err}");
+    assert!(err.contains("missing column `gyr_y`"), "{err}");
+    let _ = std::fs::remove_file(p);
+}
+
+#[test]
+fn time_going_back_is_bad_input_with_its_line() {
+    let p = tmp(
+        "time.csv",
+        format!("{HEADER}0,0,0,9.8,0,0,0\n0.005,0,0,9.8,0,0,0\n0.004,0,0,9.8,0,0,0\n").as_bytes(),
+    );
+    let (code, err) = gaitclip(&["replay", p.to_str().unwrap()]);
+    assert_eq!(code, Some(65), "{err}");
+    assert!(
+        err.contains(&format!("{}:4:1: column `t_s`", p.display())),
+        "{err}"
+    );
+    let _ = std::fs::remove_file(p);
+}
+
+#[test]
+fn a_missing_file_is_no_input() {
+    let (code, err) = gaitclip(&["replay", "/nonexistent/walk.csv"]);
+    assert_eq!(code, Some(66), "{err}");
+    assert!(err.contains("/nonexistent/walk.csv"), "{err}");
+}
+
+#[test]
+fn an_mcap_without_imu_lists_its_channels() {
+    let mut w = mcap::Writer::new(std::io::Cursor::new(Vec::new())).unwrap();
+    let schema = w.add_schema("foo.Gps", "jsonschema", b"{}").unwrap();
+    let ch = w
+        .add_channel(schema, "/gps", "json", &Default::default())
+        .unwrap();
+    let h = mcap::records::MessageHeader {
+        channel_id: ch,
+        sequence: 0,
+        log_time: 0,
+        publish_time: 0,
+    };
+    w.write_to_known_channel(&h, b"{}").unwrap();
+    w.finish().unwrap();
+    let p = tmp("gps.mcap", &w.into_inner().into_inner());
+    let (code, err) = gaitclip(&["replay", p.to_str().unwrap()]);
+    assert_eq!(code, Some(65), "{err}");
+    assert!(err.contains("channels seen: /gps (foo.Gps, json)"), "{err}");
+    let _ = std::fs::remove_file(p);
+}
+
+#[test]
+fn an_unwritable_output_is_cant_write() {
+    let demo = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../fixtures/demo_walk.csv");
+    let (code, err) = gaitclip(&[
+        "replay",
+        demo.to_str().unwrap(),
+        "--mcap-out",
+        "/nonexistent/dir/out.mcap",
+    ]);
+    assert_eq!(code, Some(74), "{err}");
+    assert!(err.contains("/nonexistent/dir/out.mcap"), "{err}");
+}
+
+#[test]
+fn a_bad_command_line_is_usage() {
+    let (code, _) = gaitclip(&["replay", "--no-such-flag"]);
+    assert_eq!(code, Some(2));
+}
