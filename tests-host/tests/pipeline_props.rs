@@ -124,11 +124,12 @@ proptest! {
         let lost = missing as usize;
         counts.drain(at..(at + lost).min(counts.len()));
         let cut = check::<1024>(&counts, 200, &[(at, missing)]);
-        // A stride wholly before the gap (and its following stance ending before it too)
-        // is untouched; so is one wholly after the gap, once detection has restarted.
+        // A stride wholly before the gap is untouched, once the stance after it has lasted
+        // long enough (1 s, 200 samples, plus the drain's reach) to say whether it was the
+        // last before rest: a gap in that stance leaves the question open.
         let gap_end = at as u32 + missing;
         for w in &whole {
-            let before = w.end + 200 < at as u32;
+            let before = w.end + 210 < at as u32;
             if before {
                 let c = cut.iter().find(|c| c.start == w.start).unwrap_or_else(|| panic!("{w:?} lost"));
                 prop_assert_eq!(c.length_mm, w.length_mm);
