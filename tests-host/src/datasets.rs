@@ -11,13 +11,20 @@ pub fn root() -> Option<PathBuf> {
 /// For tests: the datasets folder, or `None` after printing that the test was skipped.
 /// In CI (`CI=true`) a missing folder is a failure, not a skip.
 pub fn root_or_skip(test: &str) -> Option<PathBuf> {
-    match root() {
-        Some(p) => Some(p),
-        None if std::env::var("CI").is_ok_and(|v| v == "true") => {
-            panic!("{test}: ../shared/datasets is missing in CI")
+    shared_or_skip("datasets", test)
+}
+
+/// For tests: the folder `../shared/<name>`, or `None` after printing that the test was
+/// skipped. In CI (`CI=true`) a missing folder is a failure, not a skip.
+pub fn shared_or_skip(name: &str, test: &str) -> Option<PathBuf> {
+    let p = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../shared").join(name);
+    match p.is_dir() {
+        true => Some(p),
+        false if std::env::var("CI").is_ok_and(|v| v == "true") => {
+            panic!("{test}: ../shared/{name} is missing in CI")
         }
-        None => {
-            eprintln!("SKIPPED {test}: ../shared/datasets is not present");
+        false => {
+            eprintln!("SKIPPED {test}: ../shared/{name} is not present");
             None
         }
     }
