@@ -17,7 +17,9 @@ pub fn root_or_skip(test: &str) -> Option<PathBuf> {
 /// For tests: the folder `../shared/<name>`, or `None` after printing that the test was
 /// skipped. In CI (`CI=true`) a missing folder is a failure, not a skip.
 pub fn shared_or_skip(name: &str, test: &str) -> Option<PathBuf> {
-    let p = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../shared").join(name);
+    let p = PathBuf::from(env!("CARGO_MANIFEST_DIR"))
+        .join("../../shared")
+        .join(name);
     match p.is_dir() {
         true => Some(p),
         false if std::env::var("CI").is_ok_and(|v| v == "true") => {

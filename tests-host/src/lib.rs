@@ -8,6 +8,7 @@ pub mod datasets;
 pub mod eval;
 pub mod firmware;
 pub mod fixtures;
+pub mod fuzzing;
 pub mod gaps;
 pub mod length_eval;
 pub mod length_ref;

@@ -1,0 +1,110 @@
+//! The bodies of the fuzz targets (`tests-host/fuzz/fuzz_targets/`), here so that the test
+//! command replays their seed corpus and every crash ever found (`tests/fuzz_corpus.rs`)
+//! through exactly the code the fuzzer ran. Each one panics when an invariant breaks.
+
+use std::path::Path;
+
+use gaitclip::models::Model;
+use gaitclip::pipeline::{Config, Pipeline};
+use gaitclip::rate::SampleRate;
+use gaitclip::sample::{AccelRange, GyroRange, RawSample};
+use gaitclip::stride::{StrideFlags, MAX_STRIDE_MM};
+
+use crate::replay::{replay, StrideReport};
+use crate::trace::{Ranges, Trace};
+use crate::{csv_trace, mcap_io};
+
+/// The fuzz targets, by the name of their file in `fuzz/fuzz_targets/`.
+pub const TARGETS: [(&str, fn(&[u8])); 3] = [
+    ("csv_reader", csv_reader),
+    ("mcap_reader", mcap_reader),
+    ("core_pipeline", core_pipeline),
+];
+
+/// Arbitrary bytes as a CSV trace: an error, or samples that are finite with increasing
+/// time, which then replay through the core (rate from the file, else 200 Hz).
+pub fn csv_reader(data: &[u8]) {
+    let Ok(samples) = csv_trace::parse(Path::new("fuzz.csv"), data) else {
+        return;
+    };
+    check_trace(Trace {
+        rate_hz: Trace::rate_from_timestamps(&samples).unwrap_or(200.0),
+        samples,
+    });
+}
+
+/// Arbitrary bytes as an MCAP trace (gaitclip's JSON samples or ROS 2 Imu in CDR), and as
+/// one CDR Imu message: an error, or finite samples with increasing time that replay.
+pub fn mcap_reader(data: &[u8]) {
+    if let Ok(s) = mcap_io::decode_ros2_imu(data) {
+        let _ = s.t_s;
+    }
+    if let Ok(t) = mcap_io::decode(Path::new("fuzz.mcap"), data, None) {
+        check_trace(t);
+    }
+}
+
+fn check_trace(t: Trace) {
+    for w in t.samples.windows(2) {
+        assert!(w[1].t_s > w[0].t_s, "time must increase: {w:?}");
+    }
+    for s in &t.samples {
+        assert!(s.t_s.is_finite() && s.acc_mps2.iter().chain(&s.gyr_radps).all(|v| v.is_finite()));
+    }
+    // A rate outside the core's range or time that cannot be replayed is a typed error.
+    if let Ok(strides) = replay(&t, Ranges::default()) {
+        check_reports(&strides);
+    }
+}
+
+fn check_reports(strides: &[StrideReport]) {
+    for s in strides {
+        assert!(s.length_m.is_finite() && s.length_m <= MAX_STRIDE_MM as f64 / 1000.0);
+        assert!(
+            s.start_s <= s.heel_off_s && s.heel_off_s <= s.end_s,
+            "{s:?}"
+        );
+    }
+}
+
+/// Arbitrary bytes as a run of the core: byte 0 picks the rate (100–1020 Hz in steps of
+/// 4), byte 1 the length model; then 13-byte records: a control byte (≥ 0xF0: a gap of
+/// `(c & 0x0F) × 37` samples before the sample) and six big-endian i16 (accel, gyro).
+/// Every stride must be well formed: events in order, inside what was fed, lengths bounded,
+/// none across a gap with a length.
+pub fn core_pipeline(data: &[u8]) {
+    let [rate_b, model_b, rest @ ..] = data else {
+        return;
+    };
+    let Some(rate) = SampleRate::from_hz(100 + 4 * *rate_b as u32) else {
+        return;
+    };
+    let mut config = Config::new(rate, AccelRange::G16, GyroRange::Dps2000);
+    config.model = Model::ALL[*model_b as usize % Model::ALL.len()];
+    let mut p = Pipeline::new(config);
+    let mut strides = Vec::new();
+    for rec in rest.chunks_exact(13) {
+        if rec[0] >= 0xF0 {
+            strides.extend(p.gap((rec[0] & 0x0F) as u32 * 37));
+        }
+        let v = |k: usize| i16::from_be_bytes([rec[1 + 2 * k], rec[2 + 2 * k]]);
+        let s = RawSample {
+            accel: [v(0), v(1), v(2)],
+            gyro: [v(3), v(4), v(5)],
+            temp: 0,
+        };
+        strides.extend(p.process(&s));
+    }
+    strides.extend(p.finish().into_iter().flatten());
+    for (k, s) in strides.iter().enumerate() {
+        assert!(s.start <= s.heel_off && s.heel_off <= s.toe_off, "{s:?}");
+        assert!(
+            s.toe_off <= s.heel_strike && s.heel_strike <= s.end,
+            "{s:?}"
+        );
+        assert!(s.start < s.end && s.end <= p.next_index(), "{s:?}");
+        assert!(s.length_mm <= MAX_STRIDE_MM, "{s:?}");
+        assert!(!s.flags.has(StrideFlags::GAP) || s.length_mm == 0, "{s:?}");
+        assert_eq!(s.index as usize, k);
+    }
+}
