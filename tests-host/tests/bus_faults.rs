@@ -1,0 +1,266 @@
+//! Bus faults injected with `embedded-hal-mock`, every transaction spelled out: NACKs,
+//! timeouts, a wrong `WHO_AM_I`, and a sensor that stops answering mid-walk and comes back.
+//! The firmware's sampler (`boards/common/imu_sampler.rs`) counts and retries each failure,
+//! recovers the bus and re-initialises the sensor, reports the lost periods as a gap, and the
+//! pipeline reports the stride across the outage as invalid (a gap stride) and resumes: the
+//! strides before it are unchanged, the ones after it all found. No panic anywhere.
+
+#[path = "../../boards/common/imu_sampler.rs"]
+#[allow(dead_code)]
+mod imu_sampler;
+
+use embedded_hal::i2c::{ErrorKind, ErrorType, I2c, NoAcknowledgeSource, Operation};
+use embedded_hal_mock::eh1::delay::NoopDelay;
+use embedded_hal_mock::eh1::i2c::{Mock, Transaction as T};
+use gaitclip::mpu6050::{Address, Config, Mpu6050, OutputRate};
+use gaitclip::pipeline::{self, Pipeline};
+use gaitclip::rate::SampleRate;
+use gaitclip::sample::{AccelRange, GyroRange};
+use gaitclip::stride::{Stride, StrideFlags};
+use imu_sampler::{BusRecovery, Counters, ImuSampler, Item, ReadMode, RESTART_AFTER, RETRIES};
+
+// Register map (MPU-6000/6050 Register Map rev. 4.2), not imported from the driver.
+const ADDR: u8 = 0x68;
+const SMPLRT_DIV: u8 = 0x19;
+const CONFIG: u8 = 0x1A;
+const GYRO_CONFIG: u8 = 0x1B;
+const ACCEL_CONFIG: u8 = 0x1C;
+const INT_PIN_CFG: u8 = 0x37;
+const INT_ENABLE: u8 = 0x38;
+const ACCEL_XOUT_H: u8 = 0x3B;
+const PWR_MGMT_1: u8 = 0x6B;
+const WHO_AM_I: u8 = 0x75;
+
+const NACK: ErrorKind = ErrorKind::NoAcknowledge(NoAcknowledgeSource::Address);
+/// What HALs report for a clock-stretch or transfer timeout: embedded-hal has no kind of its
+/// own for it.
+const TIMEOUT: ErrorKind = ErrorKind::Other;
+
+/// The mocked bus; the board's SCL recovery always succeeds (the sampler counts it).
+struct Bus {
+    mock: Mock,
+}
+
+impl ErrorType for Bus {
+    type Error = ErrorKind;
+}
+
+impl I2c for Bus {
+    fn read(&mut self, a: u8, b: &mut [u8]) -> Result<(), ErrorKind> {
+        self.mock.read(a, b)
+    }
+    fn write(&mut self, a: u8, b: &[u8]) -> Result<(), ErrorKind> {
+        self.mock.write(a, b)
+    }
+    fn write_read(&mut self, a: u8, w: &[u8], r: &mut [u8]) -> Result<(), ErrorKind> {
+        self.mock.write_read(a, w, r)
+    }
+    fn transaction(&mut self, a: u8, ops: &mut [Operation<'_>]) -> Result<(), ErrorKind> {
+        self.mock.transaction(a, ops)
+    }
+}
+
+impl BusRecovery for Bus {
+    fn recover_bus(&mut self) -> bool {
+        true
+    }
+}
+
+/// The expected transactions, written as the sampler must issue them.
+#[derive(Default)]
+struct Script(Vec<T>);
+
+impl Script {
+    /// Set-up at 200 Hz, ±16 g, ±2000 °/s, data-ready interrupt latched.
+    fn init(&mut self) {
+        self.0.extend([
+            T::write_read(ADDR, vec![WHO_AM_I], vec![0x68]),
+            T::write(ADDR, vec![PWR_MGMT_1, 0x80]),
+            T::write(ADDR, vec![PWR_MGMT_1, 0x01]),
+            T::write(ADDR, vec![SMPLRT_DIV, 4]),
+            T::write(ADDR, vec![CONFIG, 2]),
+            T::write(ADDR, vec![GYRO_CONFIG, 3 << 3]),
+            T::write(ADDR, vec![ACCEL_CONFIG, 3 << 3]),
+            T::write(ADDR, vec![INT_PIN_CFG, 0x30]),
+            T::write(ADDR, vec![INT_ENABLE, 0x11]),
+        ]);
+    }
+    /// A set-up that stops at the probe: no answer.
+    fn init_unanswered(&mut self) {
+        self.0
+            .push(T::write_read(ADDR, vec![WHO_AM_I], vec![0]).with_error(NACK));
+    }
+    /// A set-up that stops at the probe: another part answers.
+    fn init_wrong_device(&mut self, who: u8) {
+        self.0.push(T::write_read(ADDR, vec![WHO_AM_I], vec![who]));
+    }
+    fn read(&mut self, sample: &[u8]) {
+        self.0
+            .push(T::write_read(ADDR, vec![ACCEL_XOUT_H], sample.to_vec()));
+    }
+    fn read_fails(&mut self, kind: ErrorKind) {
+        self.0
+            .push(T::write_read(ADDR, vec![ACCEL_XOUT_H], vec![0; 14]).with_error(kind));
+    }
+}
+
+fn trace() -> Vec<[u8; 14]> {
+    let bytes = std::fs::read(
+        std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../fixtures/demo_walk.mpu6050"),
+    )
+    .unwrap();
+    bytes
+        .chunks_exact(14)
+        .map(|c| c.try_into().unwrap())
+        .collect()
+}
+
+/// Runs one data-ready pulse per entry of `pulses` through the sampler and every item
+/// through the pipeline, as the firmware's main loop does; checks the bus saw exactly the
+/// script.
+fn run(script: Script, pulses: usize) -> (Vec<Stride>, Vec<Item>, Counters) {
+    let mut mock = Mock::new(&script.0);
+    let bus = Bus { mock: mock.clone() };
+    let config = Config::new(OutputRate::from_hz(200).unwrap());
+    let Ok(mut sampler) = ImuSampler::start(
+        Mpu6050::new(bus, Address::Ad0Low),
+        NoopDelay,
+        config,
+        ReadMode::PerSample,
+    ) else {
+        panic!("the sensor starts");
+    };
+    let rate = SampleRate::from_hz(200).unwrap();
+    let mut p = Pipeline::new(pipeline::Config::new(
+        rate,
+        AccelRange::G16,
+        GyroRange::Dps2000,
+    ));
+    let (mut items, mut strides) = (Vec::new(), Vec::new());
+    for _ in 0..pulses {
+        sampler.on_data_ready(&mut |i| {
+            items.push(i);
+            true
+        });
+    }
+    for i in &items {
+        strides.extend(i.feed(&mut p));
+    }
+    strides.extend(p.finish().into_iter().flatten());
+    // The clone shares the expectations: every scripted transaction happened, no more.
+    mock.done();
+    (strides, items, sampler.counters())
+}
+
+/// The demo walk read cleanly: the reference.
+fn clean(n: usize) -> Vec<Stride> {
+    let t = trace();
+    let mut s = Script::default();
+    s.init();
+    for x in &t[..n] {
+        s.read(x);
+    }
+    run(s, n).0
+}
+
+#[test]
+fn nacks_and_timeouts_are_retried_and_lose_nothing() {
+    let t = trace();
+    let n = t.len();
+    let mut s = Script::default();
+    s.init();
+    for (k, x) in t.iter().enumerate() {
+        match k % 500 {
+            // A NACK, then the retry reads it.
+            100 => s.read_fails(NACK),
+            // Two timeouts in a row, the last retry reads it.
+            300 => {
+                s.read_fails(TIMEOUT);
+                s.read_fails(TIMEOUT);
+            }
+            _ => {}
+        }
+        s.read(x);
+    }
+    let nacks = (0..n).filter(|k| k % 500 == 100).count() as u32;
+    let timeouts = 2 * (0..n).filter(|k| k % 500 == 300).count() as u32;
+    let (strides, items, c) = run(s, n);
+    assert_eq!(c.bus_errors, nacks + timeouts, "{c:?}");
+    assert_eq!(
+        (c.lost_samples, c.restarts, c.recoveries),
+        (0, 0, 0),
+        "{c:?}"
+    );
+    assert!(items.iter().all(|i| matches!(i, Item::Sample(_))));
+    assert_eq!(strides, clean(n), "retried reads give the same strides");
+}
+
+#[test]
+fn a_sensor_that_stops_mid_walk_is_restarted_and_its_stride_marked() {
+    let t = trace();
+    let n = t.len();
+    let reference = clean(n);
+    // Stop in the swing of a stride in the middle of the walk.
+    let mid = reference[reference.len() / 2];
+    let stop = ((mid.toe_off + mid.heel_strike) / 2) as usize;
+    // Out for OUT periods: each read fails all its attempts; from the RESTART_AFTER-th
+    // failed period on, each one recovers the bus and tries a set-up: the first finds
+    // nobody, the second a part that is not an MPU6050 (the bus still settling), the third
+    // the sensor, back.
+    const OUT: usize = RESTART_AFTER as usize + 2;
+    let mut s = Script::default();
+    s.init();
+    for x in &t[..stop] {
+        s.read(x);
+    }
+    for period in 1..=OUT {
+        for _ in 0..=RETRIES {
+            s.read_fails(NACK);
+        }
+        match period.checked_sub(RESTART_AFTER as usize) {
+            Some(0) => s.init_unanswered(),
+            Some(1) => s.init_wrong_device(0x70),
+            Some(_) => s.init(),
+            None => {}
+        }
+    }
+    // The sensor answers again; the samples of the outage are gone.
+    for x in &t[stop + OUT..] {
+        s.read(x);
+    }
+    let pulses = n;
+    let (strides, items, c) = run(s, pulses);
+    assert_eq!(c.bus_errors, (OUT as u32) * (RETRIES + 1) + 2, "{c:?}");
+    assert_eq!((c.restarts, c.recoveries), (1, 3), "{c:?}");
+    assert_eq!(c.lost_samples, OUT as u32, "{c:?}");
+    // Every pulse is a sample or part of a gap; the gap is where the outage was.
+    let gaps: Vec<(usize, u32)> = items
+        .iter()
+        .enumerate()
+        .filter_map(|(k, i)| match i {
+            Item::Gap(g) => Some((k, *g)),
+            Item::Sample(_) => None,
+        })
+        .collect();
+    assert_eq!(gaps, vec![(stop, OUT as u32)]);
+    assert_eq!(items.len() - 1, n - OUT);
+    // The stride across the outage: reported once, invalid, no length.
+    let gap: Vec<&Stride> = strides
+        .iter()
+        .filter(|s| s.flags.has(StrideFlags::GAP))
+        .collect();
+    assert_eq!(gap.len(), 1, "{strides:#?}");
+    assert_eq!(gap[0].start, mid.start);
+    assert_eq!(gap[0].length_mm, 0);
+    assert!(!gap[0].flags.valid());
+    // Before it, nothing changed; after it, every stride is found again at the same place.
+    assert_eq!(strides.len(), reference.len());
+    for (a, b) in reference.iter().zip(&strides) {
+        if a.end < mid.start {
+            assert_eq!(a, b);
+        } else if a.start > mid.end {
+            assert_eq!((a.start, a.end, a.zupt_um), (b.start, b.end, b.zupt_um));
+            assert!(b.flags.valid() == a.flags.valid(), "{a:?} vs {b:?}");
+        }
+    }
+}
