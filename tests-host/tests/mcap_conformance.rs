@@ -123,9 +123,7 @@ fn reencode(name: &str, records: &[(String, Vec<Value>)]) -> Vec<u8> {
         .repeat_channels(has("rch"));
     let mut w = opts.create(Cursor::new(Vec::new())).unwrap();
     // Records after DataEnd are the summary, which the writer makes itself.
-    let data_section = records
-        .iter()
-        .take_while(|(ty, _)| ty != "DataEnd");
+    let data_section = records.iter().take_while(|(ty, _)| ty != "DataEnd");
     for (ty, f) in data_section {
         match ty.as_str() {
             "Schema" => {
@@ -206,7 +204,8 @@ fn classify(path: &Path, e: McapError) -> String {
 
 #[test]
 fn conformance_files_are_read_exactly_or_rejected_clearly() {
-    let Some(root) = gaitclip_host::datasets::shared_or_skip("mcap-conformance", "mcap_conformance")
+    let Some(root) =
+        gaitclip_host::datasets::shared_or_skip("mcap-conformance", "mcap_conformance")
     else {
         return;
     };
