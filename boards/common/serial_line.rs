@@ -10,7 +10,7 @@
 //! # hold still: waiting for the clip to rest (2 s)
 //! # still: gyro_bias_mdps=-1220,305,61 gravity_mg=1003
 //! 0,5120,1362,1105,420,150,380,155,3,4,1
-//! # gap samples=12: the stride in progress is dropped
+//! # gap samples=12: the stride in progress is reported invalid (flag 64), without a length
 //! # status samples=24000 strides=96 distance_mm=131012 bus_errors=0 restarts=0 fifo_overflows=0 silences=0 overruns=0 lost_samples=0
 //! ```
 //!

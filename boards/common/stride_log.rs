@@ -135,12 +135,12 @@ impl StrideLog {
     /// Reports a gap in the samples.
     pub fn gap(&self, samples: u32, serial: &mut impl Write) {
         defmt::warn!(
-            "gap of {=u32} samples: the stride in progress is dropped",
+            "gap of {=u32} samples: the stride in progress is reported invalid, without a length",
             samples
         );
         let _ = serial_line::comment(
             serial,
-            format_args!("gap samples={}: the stride in progress is dropped", samples),
+            format_args!("gap samples={}: the stride in progress is reported invalid, without a length", samples),
         );
     }
 

@@ -27,7 +27,12 @@ const GYRO_CONFIG: u8 = 0x1B;
 const ACCEL_CONFIG: u8 = 0x1C;
 const INT_PIN_CFG: u8 = 0x37;
 const INT_ENABLE: u8 = 0x38;
+const INT_STATUS: u8 = 0x3A;
 const ACCEL_XOUT_H: u8 = 0x3B;
+const FIFO_EN: u8 = 0x23;
+const USER_CTRL: u8 = 0x6A;
+const FIFO_COUNT_H: u8 = 0x72;
+const FIFO_R_W: u8 = 0x74;
 const PWR_MGMT_1: u8 = 0x6B;
 const WHO_AM_I: u8 = 0x75;
 
@@ -83,6 +88,36 @@ impl Script {
             T::write(ADDR, vec![ACCEL_CONFIG, 3 << 3]),
             T::write(ADDR, vec![INT_PIN_CFG, 0x30]),
             T::write(ADDR, vec![INT_ENABLE, 0x11]),
+        ]);
+    }
+    /// Set-up in FIFO mode: the same registers, then the FIFO and a pulsed interrupt.
+    fn init_fifo(&mut self) {
+        self.init();
+        self.0.truncate(self.0.len() - 2);
+        self.0.extend([
+            T::write(ADDR, vec![USER_CTRL, 0x04]),
+            T::write(ADDR, vec![FIFO_EN, 0xF8]),
+            T::write(ADDR, vec![USER_CTRL, 0x40]),
+            T::write(ADDR, vec![INT_PIN_CFG, 0x00]),
+            T::write(ADDR, vec![INT_ENABLE, 0x01]),
+        ]);
+    }
+    /// A FIFO burst holding `samples`.
+    fn fifo(&mut self, samples: &[[u8; 14]]) {
+        let bytes = (samples.len() * 14) as u16;
+        self.0.extend([
+            T::write_read(ADDR, vec![INT_STATUS], vec![0x01]),
+            T::write_read(ADDR, vec![FIFO_COUNT_H], bytes.to_be_bytes().to_vec()),
+        ]);
+        for x in samples {
+            self.0.push(T::write_read(ADDR, vec![FIFO_R_W], x.to_vec()));
+        }
+    }
+    /// A FIFO read that finds the overflow flag: the FIFO is reset.
+    fn fifo_overflowed(&mut self) {
+        self.0.extend([
+            T::write_read(ADDR, vec![INT_STATUS], vec![0x11]),
+            T::write(ADDR, vec![USER_CTRL, 0x44]),
         ]);
     }
     /// A set-up that stops at the probe: no answer.
@@ -263,4 +298,91 @@ fn a_sensor_that_stops_mid_walk_is_restarted_and_its_stride_marked() {
             assert!(b.flags.valid() == a.flags.valid(), "{a:?} vs {b:?}");
         }
     }
+}
+
+/// The sampler in FIFO mode over the mock, batch of 4 pulses per read.
+fn fifo_sampler(script: &Script) -> (Mock, ImuSampler<Bus, NoopDelay>) {
+    let mock = Mock::new(&script.0);
+    let Ok(sampler) = ImuSampler::start(
+        Mpu6050::new(Bus { mock: mock.clone() }, Address::Ad0Low),
+        NoopDelay,
+        Config::new(OutputRate::from_hz(200).unwrap()),
+        ReadMode::Fifo { batch: 4 },
+    ) else {
+        panic!("the sensor starts");
+    };
+    (mock, sampler)
+}
+
+#[test]
+fn a_fifo_overflow_becomes_a_gap_of_what_it_cost() {
+    let t = trace();
+    let mut s = Script::default();
+    s.init_fifo();
+    s.fifo(&t[0..4]);
+    // At the next read (pulse 8) the FIFO had overflowed (reads held off, a glitch on the
+    // bus): it is reset, and the four samples pulsed since the last read are lost.
+    s.fifo_overflowed();
+    s.fifo(&t[8..12]);
+    let (mut mock, mut sampler) = fifo_sampler(&s);
+    let mut items = Vec::new();
+    for _ in 0..12 {
+        sampler.on_data_ready(&mut |i| {
+            items.push(i);
+            true
+        });
+    }
+    mock.done();
+    let c = sampler.counters();
+    assert_eq!(
+        (c.fifo_overflows, c.lost_samples, c.bus_errors),
+        (1, 4, 0),
+        "{c:?}"
+    );
+    let want: Vec<Item> = t[0..4]
+        .iter()
+        .map(|x| Item::Sample(gaitclip::sample::RawSample::from_be_bytes(x)))
+        .chain([Item::Gap(4)])
+        .chain(
+            t[8..12]
+                .iter()
+                .map(|x| Item::Sample(gaitclip::sample::RawSample::from_be_bytes(x))),
+        )
+        .collect();
+    assert_eq!(items, want);
+}
+
+#[test]
+fn a_silent_sensor_found_by_the_watchdog_is_set_up_again_and_the_silence_is_a_gap() {
+    let t = trace();
+    let mut s = Script::default();
+    s.init_fifo();
+    s.fifo(&t[0..4]);
+    // 60 periods without a pulse (the sensor browned out); the watchdog calls on_silence:
+    // the bus is recovered and the sensor set up again.
+    s.init_fifo();
+    s.fifo(&t[70..74]);
+    let (mut mock, mut sampler) = fifo_sampler(&s);
+    let mut items = Vec::new();
+    let mut push = |i| {
+        items.push(i);
+        true
+    };
+    for _ in 0..6 {
+        sampler.on_data_ready(&mut push);
+    }
+    // Two pulses were counted but never read: they are part of the silence's gap.
+    sampler.on_silence(60, &mut push);
+    for _ in 0..4 {
+        sampler.on_data_ready(&mut push);
+    }
+    mock.done();
+    let c = sampler.counters();
+    assert_eq!(
+        (c.silences, c.restarts, c.recoveries, c.lost_samples),
+        (1, 1, 1, 62),
+        "{c:?}"
+    );
+    assert_eq!(items.len(), 4 + 1 + 4);
+    assert_eq!(items[4], Item::Gap(62));
 }
