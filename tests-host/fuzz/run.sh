@@ -1,6 +1,7 @@
 #!/usr/bin/env bash
-# Runs every fuzz target for a fixed number of executions (default 1 000 000 each):
-#   bash tests-host/fuzz/run.sh [RUNS]
+# Runs every fuzz target (or those named) for a fixed number of executions (default
+# 1 000 000 each):
+#   bash tests-host/fuzz/run.sh [RUNS [TARGET...]]
 # Needs a nightly toolchain (installed here with rustup if missing) and cargo-fuzz. Each
 # target starts from its seed corpus in corpus/<target>/ (new inputs the fuzzer finds go to
 # target/fuzz-corpus/, not into the repository). A crash stops the run and leaves its input
@@ -8,11 +9,14 @@
 # test command replays it from then on.
 set -euo pipefail
 runs=${1:-1000000}
+shift || true
+targets=("$@")
+[ ${#targets[@]} -gt 0 ] || targets=(csv_reader mcap_reader core_pipeline)
 here=$(cd "$(dirname "${BASH_SOURCE[0]}")" && pwd)
 cd "$here"
 rustup toolchain list | grep -q '^nightly' || rustup toolchain install nightly --profile minimal
 command -v cargo-fuzz >/dev/null || cargo install cargo-fuzz --locked
-for t in csv_reader mcap_reader core_pipeline; do
+for t in "${targets[@]}"; do
   work="$here/target/fuzz-corpus/$t"
   mkdir -p "$work"
   echo "== $t: $runs executions"

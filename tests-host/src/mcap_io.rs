@@ -101,6 +101,10 @@ fn imu_kind(schema: &str, message_encoding: &str) -> Option<ImuKind> {
     }
 }
 
+/// The largest record (or decompressed chunk) the reader accepts, bytes: far above any IMU
+/// trace's chunks, far below what would exhaust a host's memory.
+pub const MAX_RECORD_BYTES: usize = 256 << 20;
+
 /// A schema, channel or message record as a streamed reader sees it (chunks opened, the
 /// summary section included): what the MCAP conformance files list.
 #[derive(Clone, Debug, PartialEq, Eq)]
@@ -168,8 +172,25 @@ pub fn read_records(path: &Path, bytes: &[u8]) -> Result<Vec<McapRecord>, McapEr
         source,
     };
     let mut out = Vec::new();
-    for r in mcap::read::ChunkFlattener::new(bytes).map_err(fmt)? {
-        match r.map_err(fmt)? {
+    // The `mcap` crate's sans-io reader, fed from the slice, with a bound on record sizes: a
+    // chunk header may claim any uncompressed size, and the reader allocates what it claims
+    // (found by fuzzing: 2⁵⁶ bytes aborts the process).
+    let mut reader = mcap::sans_io::LinearReader::new_with_options(
+        mcap::sans_io::LinearReaderOptions::default().with_record_length_limit(MAX_RECORD_BYTES),
+    );
+    let mut rest = bytes;
+    while let Some(event) = reader.next_event() {
+        let (opcode, data) = match event.map_err(fmt)? {
+            mcap::sans_io::LinearReadEvent::ReadRequest(need) => {
+                let n = need.min(rest.len());
+                reader.insert(n).copy_from_slice(&rest[..n]);
+                reader.notify_read(n);
+                rest = &rest[n..];
+                continue;
+            }
+            mcap::sans_io::LinearReadEvent::Record { data, opcode } => (opcode, data),
+        };
+        match mcap::parse_record(opcode, data).map_err(fmt)? {
             mcap::records::Record::Schema { header, data } => out.push(McapRecord::Schema {
                 id: header.id,
                 name: header.name,
