@@ -2,8 +2,9 @@
 # Runs every check of gaitclip, as CI does: formatting and clippy (-D warnings) in every
 # workspace, firmware builds for both Cortex-M targets and every board (nRF52840-DK,
 # Raspberry Pi Pico, QEMU micro:bit), and the host test suite (driver transactions, fixed
-# point vs f64, fixtures, MCAP/CSV readers, real datasets when ../shared/datasets is
-# present, the bit-exact QEMU runs of the M4 and M0 firmware, and the instruction counts of
+# point vs f64, fixtures, MCAP/CSV readers and the MCAP conformance files, bus faults, gaps,
+# jitter and saturation, property tests, the fuzz corpus and regressions, real datasets when
+# ../shared/datasets is present, the bit-exact QEMU runs of the M4 and M0 firmware, and the instruction counts of
 # the cost benchmark). The cost figures themselves come from tests-host/cost.sh.
 # Installs what a fresh Debian machine lacks: qemu-system-arm (apt) and flip-link (cargo).
 # rustup installs the toolchain, targets and components named in rust-toolchain.toml.
@@ -36,6 +37,9 @@ echo "== benchmark firmware (boards/bench): rustfmt, clippy, builds for both tar
 echo "== tests-host (and the qemu-insn-count plugin): rustfmt, clippy, tests"
 cd "$root/tests-host"
 cargo fmt --check
+# The fuzz targets are their own workspace, built by cargo-fuzz on nightly (fuzz/run.sh); their
+# bodies are in src/fuzzing.rs and their corpus is replayed by tests/fuzz_corpus.rs below.
+cargo fmt --check --manifest-path fuzz/Cargo.toml
 cargo clippy --workspace --all-targets -- -D warnings
 log=$(mktemp)
 cargo test --workspace 2>&1 | tee "$log"

@@ -52,6 +52,18 @@ pub enum McapError {
         /// The parser's error.
         source: mcap::McapError,
     },
+    /// A record's fields do not fit it.
+    #[error(
+        "{path}: record with opcode {opcode:#04x}: {what} runs past the record or is not UTF-8"
+    )]
+    BadRecord {
+        /// The file.
+        path: PathBuf,
+        /// The record's opcode.
+        opcode: u8,
+        /// The field.
+        what: String,
+    },
     /// The file is a git-LFS pointer: the recording itself was never fetched.
     #[error("{path}: a git-LFS pointer ({size} bytes of MCAP not fetched, {oid}), not an MCAP file: run `git lfs pull` in the repository it came from")]
     LfsPointer {
@@ -190,31 +202,92 @@ pub fn read_records(path: &Path, bytes: &[u8]) -> Result<Vec<McapRecord>, McapEr
             }
             mcap::sans_io::LinearReadEvent::Record { data, opcode } => (opcode, data),
         };
-        match mcap::parse_record(opcode, data).map_err(fmt)? {
-            mcap::records::Record::Schema { header, data } => out.push(McapRecord::Schema {
-                id: header.id,
-                name: header.name,
-                encoding: header.encoding,
-                data: data.into_owned(),
-            }),
-            mcap::records::Record::Channel(c) => out.push(McapRecord::Channel {
-                id: c.id,
-                schema_id: c.schema_id,
-                topic: c.topic,
-                message_encoding: c.message_encoding,
-                metadata: c.metadata,
-            }),
-            mcap::records::Record::Message { header, data } => out.push(McapRecord::Message {
-                channel_id: header.channel_id,
-                sequence: header.sequence,
-                log_time: header.log_time,
-                publish_time: header.publish_time,
-                data: data.into_owned(),
-            }),
+        // Schema, channel and message records are decoded here, every length prefix checked
+        // against the record: the `mcap` crate's parser reserves whatever a string's prefix
+        // claims (found by fuzzing: 4 GiB for a header's library name). Other records carry
+        // nothing a trace needs and are skipped.
+        let bad = |what: &str| McapError::BadRecord {
+            path: path.to_owned(),
+            opcode,
+            what: what.to_owned(),
+        };
+        match opcode {
+            mcap::records::op::SCHEMA => {
+                let mut f = Fields(data);
+                out.push(McapRecord::Schema {
+                    id: f.u16().ok_or_else(|| bad("schema id"))?,
+                    name: f.string().ok_or_else(|| bad("schema name"))?,
+                    encoding: f.string().ok_or_else(|| bad("schema encoding"))?,
+                    data: f.bytes().ok_or_else(|| bad("schema data"))?.to_vec(),
+                });
+            }
+            mcap::records::op::CHANNEL => {
+                let mut f = Fields(data);
+                out.push(McapRecord::Channel {
+                    id: f.u16().ok_or_else(|| bad("channel id"))?,
+                    schema_id: f.u16().ok_or_else(|| bad("channel schema id"))?,
+                    topic: f.string().ok_or_else(|| bad("channel topic"))?,
+                    message_encoding: f.string().ok_or_else(|| bad("message encoding"))?,
+                    metadata: f.map().ok_or_else(|| bad("channel metadata"))?,
+                });
+            }
+            mcap::records::op::MESSAGE => {
+                let mut f = Fields(data);
+                out.push(McapRecord::Message {
+                    channel_id: f.u16().ok_or_else(|| bad("message channel id"))?,
+                    sequence: f.u32().ok_or_else(|| bad("message sequence"))?,
+                    log_time: f.u64().ok_or_else(|| bad("message log time"))?,
+                    publish_time: f.u64().ok_or_else(|| bad("message publish time"))?,
+                    data: f.0.to_vec(),
+                });
+            }
             _ => {}
         }
     }
     Ok(out)
+}
+
+/// The fields of an MCAP record, little-endian, read front to back; `None` when a field or
+/// a length prefix runs past the record.
+struct Fields<'a>(&'a [u8]);
+
+impl<'a> Fields<'a> {
+    fn take(&mut self, n: usize) -> Option<&'a [u8]> {
+        if n > self.0.len() {
+            return None;
+        }
+        let (head, tail) = self.0.split_at(n);
+        self.0 = tail;
+        Some(head)
+    }
+    fn u16(&mut self) -> Option<u16> {
+        Some(u16::from_le_bytes(self.take(2)?.try_into().ok()?))
+    }
+    fn u32(&mut self) -> Option<u32> {
+        Some(u32::from_le_bytes(self.take(4)?.try_into().ok()?))
+    }
+    fn u64(&mut self) -> Option<u64> {
+        Some(u64::from_le_bytes(self.take(8)?.try_into().ok()?))
+    }
+    /// A `uint32` length and that many bytes.
+    fn bytes(&mut self) -> Option<&'a [u8]> {
+        let n = self.u32()? as usize;
+        self.take(n)
+    }
+    fn string(&mut self) -> Option<String> {
+        String::from_utf8(self.bytes()?.to_vec()).ok()
+    }
+    /// A map of strings: a `uint32` byte length, then key-value pairs filling it.
+    fn map(&mut self) -> Option<BTreeMap<String, String>> {
+        let mut inner = Fields(self.bytes()?);
+        let mut m = BTreeMap::new();
+        while !inner.0.is_empty() {
+            let k = inner.string()?;
+            let v = inner.string()?;
+            m.insert(k, v);
+        }
+        Some(m)
+    }
 }
 
 /// Reads the IMU samples of the first IMU channel (the first to carry a message) of an
