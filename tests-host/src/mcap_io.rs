@@ -183,6 +183,7 @@ pub fn read_records(path: &Path, bytes: &[u8]) -> Result<Vec<McapRecord>, McapEr
         path: path.to_owned(),
         source,
     };
+    check_uncompressed_chunks(path, bytes)?;
     let mut out = Vec::new();
     // The `mcap` crate's sans-io reader, fed from the slice, with a bound on record sizes: a
     // chunk header may claim any uncompressed size, and the reader allocates what it claims
@@ -288,6 +289,57 @@ impl<'a> Fields<'a> {
         }
         Some(m)
     }
+}
+
+/// Walks the file's top-level records and, inside every uncompressed chunk, the records'
+/// lengths: the `mcap` crate's reader subtracts a record's length from what is left of the
+/// chunk without checking it (found by fuzzing: an overflow panic in `linear_reader.rs`).
+/// Whatever else is wrong with the file is left to that reader to report.
+fn check_uncompressed_chunks(path: &Path, bytes: &[u8]) -> Result<(), McapError> {
+    const CHUNK: u8 = 0x06;
+    let bad = || McapError::BadRecord {
+        path: path.to_owned(),
+        opcode: CHUNK,
+        what: "a record inside the chunk".to_owned(),
+    };
+    let mut file = Fields(bytes.get(8..).unwrap_or(&[]));
+    while file.0.len() > 8 {
+        let (Some(op), Some(len)) = (file.take(1), file.u64()) else {
+            break;
+        };
+        // A record running past the end of the file is read as far as it goes: the reader
+        // streams a chunk's records before it knows the chunk is cut short.
+        let n = usize::try_from(len).unwrap_or(usize::MAX).min(file.0.len());
+        let Some(body) = file.take(n) else { break };
+        if op[0] != CHUNK {
+            continue;
+        }
+        let mut chunk = Fields(body);
+        let header = (chunk.u64(), chunk.u64(), chunk.u64(), chunk.u32());
+        let (Some(compression), Some(records_len)) = (chunk.bytes(), chunk.u64()) else {
+            continue;
+        };
+        if !compression.is_empty() || header.3.is_none() {
+            continue;
+        }
+        // Every record inside must fit in what the chunk declares is left.
+        let mut declared = records_len;
+        let mut inner = chunk;
+        while declared > 0 {
+            let (Some(_), Some(len)) = (inner.take(1), inner.u64()) else {
+                break;
+            };
+            let whole = len
+                .checked_add(9)
+                .filter(|&w| w <= declared)
+                .ok_or_else(bad)?;
+            declared -= whole;
+            let Some(_) = usize::try_from(len).ok().and_then(|n| inner.take(n)) else {
+                break;
+            };
+        }
+    }
+    Ok(())
 }
 
 /// Reads the IMU samples of the first IMU channel (the first to carry a message) of an
