@@ -140,7 +140,10 @@ impl StrideLog {
         );
         let _ = serial_line::comment(
             serial,
-            format_args!("gap samples={}: the stride in progress is reported invalid, without a length", samples),
+            format_args!(
+                "gap samples={}: the stride in progress is reported invalid, without a length",
+                samples
+            ),
         );
     }
 

@@ -14,8 +14,11 @@ use crate::replay::{replay, StrideReport};
 use crate::trace::{Ranges, Trace};
 use crate::{csv_trace, mcap_io};
 
+/// A fuzz target's body: panics when an invariant breaks.
+pub type Target = fn(&[u8]);
+
 /// The fuzz targets, by the name of their file in `fuzz/fuzz_targets/`.
-pub const TARGETS: [(&str, fn(&[u8])); 3] = [
+pub const TARGETS: [(&str, Target); 3] = [
     ("csv_reader", csv_reader),
     ("mcap_reader", mcap_reader),
     ("core_pipeline", core_pipeline),
