@@ -4,7 +4,14 @@ use std::path::PathBuf;
 
 /// The datasets folder beside the repository, if present.
 pub fn root() -> Option<PathBuf> {
-    let p = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../shared/datasets");
+    shared("datasets")
+}
+
+/// The folder `../shared/<name>` beside the repository, if present.
+pub fn shared(name: &str) -> Option<PathBuf> {
+    let p = PathBuf::from(env!("CARGO_MANIFEST_DIR"))
+        .join("../../shared")
+        .join(name);
     p.is_dir().then_some(p)
 }
 
