@@ -11,11 +11,23 @@
 //! Each stage is fed only the records of the stage before it. The delays of the centred
 //! windows are undone by delay lines, so that every stride index is the number of the raw
 //! sample it names.
+//!
+//! **Two detectors.** [`Detector::Stance`] (the default) is the chain above.
+//! [`Detector::PeakValley`] replaces the stance detector and stride tracker with Lu's
+//! peak-valley detector ([`crate::peak_valley`]) on the foot frame's vertical acceleration,
+//! and measures each of its steps with Lu's own chain, fuzzy `k` and Weinberg
+//! ([`crate::models::lu_chain_um`]):
+//!
+//! ```text
+//! raw sample ─ mean filter ─ rotate into the foot frame ─ vertical ─ peak-valley detector
+//!                                                          step ─→ D, f ─→ fuzzy k ─→ Weinberg
+//! ```
 
 use crate::features::Features;
 use crate::foot_frame::FootFrameEstimator;
 use crate::mean_filter::MeanFilter;
 use crate::models::{self, Model, ModelParams, Settings};
+use crate::peak_valley::{PeakValleyDetector, Step};
 use crate::phases::PhaseMethod;
 use crate::rate::SampleRate;
 use crate::rest::{RestDetector, RestThresholds};
@@ -36,6 +48,35 @@ pub const DELAY_CAPACITY: usize = 128;
 /// table for why).
 pub const DEFAULT_MODEL: Model = Model::HuangSvrFusion;
 
+/// Which step detector segments the walk.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Detector {
+    /// Stance to stance (Huang's zero-velocity detector), with gait events, phases, the
+    /// ZUPT displacement and every length model: the default.
+    Stance,
+    /// Lu's peak-valley detection on vertical acceleration; a stride record is one of its
+    /// steps (see [`Stride`]'s fields), measured by Lu's chain whatever the configured model.
+    PeakValley,
+}
+
+impl Detector {
+    /// Both, default first.
+    pub const ALL: [Detector; 2] = [Detector::Stance, Detector::PeakValley];
+
+    /// The name `--detector` takes.
+    pub const fn name(self) -> &'static str {
+        match self {
+            Detector::Stance => "stance",
+            Detector::PeakValley => "lu",
+        }
+    }
+
+    /// The detector called `name`.
+    pub fn from_name(name: &str) -> Option<Detector> {
+        Detector::ALL.into_iter().find(|d| d.name() == name)
+    }
+}
+
 /// What the pipeline needs to know about the data.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct Config {
@@ -45,6 +86,8 @@ pub struct Config {
     pub accel: AccelRange,
     /// Gyroscope range the counts are in.
     pub gyro: GyroRange,
+    /// Step detector.
+    pub detector: Detector,
     /// Phase splitter version.
     pub phases: PhaseMethod,
     /// The model that fills in [`Stride::length_mm`].
@@ -56,14 +99,15 @@ pub struct Config {
 }
 
 impl Config {
-    /// The default configuration for data at `rate` in the given ranges: the augmented
-    /// phase splitter, the [`DEFAULT_MODEL`] with the shipped [`crate::trained::PARAMS`],
-    /// and the default height.
+    /// The default configuration for data at `rate` in the given ranges: the stance
+    /// detector, the augmented phase splitter, the [`DEFAULT_MODEL`] with the shipped
+    /// [`crate::trained::PARAMS`], and the default height.
     pub const fn new(rate: SampleRate, accel: AccelRange, gyro: GyroRange) -> Self {
         Config {
             rate,
             accel,
             gyro,
+            detector: Detector::Stance,
             phases: PhaseMethod::Augmented,
             model: DEFAULT_MODEL,
             settings: Settings::DEFAULT,
@@ -94,6 +138,8 @@ pub struct Pipeline<const M: usize = MAX_MOVEMENT_SAMPLES> {
     frame: FootFrameEstimator,
     stance: StanceDetector,
     tracker: StrideTracker<M>,
+    detector: Detector,
+    peaks: PeakValleyDetector,
     rate: SampleRate,
     model: Model,
     settings: Settings,
@@ -138,6 +184,8 @@ impl<const M: usize> Pipeline<M> {
             frame: FootFrameEstimator::new(config.rate, config.accel),
             stance,
             tracker: StrideTracker::sized(config.rate, config.gyro, config.phases),
+            detector: config.detector,
+            peaks: PeakValleyDetector::new(config.rate),
             rate: config.rate,
             model: config.model,
             settings: config.settings,
@@ -197,6 +245,14 @@ impl<const M: usize> Pipeline<M> {
         }
         let frame = self.frame.frame()?;
         let foot = frame.apply(filtered);
+        if self.detector == Detector::PeakValley {
+            // The filtered value is the mean of a window centred `delay` samples back.
+            let at = index.wrapping_sub(self.filter.delay());
+            return self
+                .peaks
+                .process(at, foot[2])
+                .map(|s| self.measure_step(s));
+        }
         self.foot_line[slot(index)] = foot;
         let decision = self.stance.process(foot, s.gyro)?;
         self.stance_fed = self.stance_fed.saturating_add(1);
@@ -218,8 +274,20 @@ impl<const M: usize> Pipeline<M> {
     /// is found after the gap), and detection restarts after it. Returns the stride the drain
     /// let the tracker report or that it held, complete and measured as usual.
     // Not inlined: its strides would otherwise sit in the caller's frame on the sample path.
+    ///
+    /// With [`Detector::PeakValley`] the steps in flight are decided as at the end of a
+    /// recording and come out of the next calls to [`Pipeline::process`].
     #[inline(never)]
     pub fn gap(&mut self, missing: u32) -> Option<Stride> {
+        if self.detector == Detector::PeakValley {
+            self.peaks.gap();
+            self.next = self.next.wrapping_add(missing);
+            self.since_reset = 0;
+            self.filter = MeanFilter::with_len_log2(self.filter.window().trailing_zeros());
+            self.rest.reset();
+            self.frame.gap();
+            return None;
+        }
         // The drain runs on one stance decision, so it makes one transition at most, and
         // then the tracker holds nothing to hand back; should both ever carry a stride, the
         // later one stays held (reported after the gap), so nothing is lost.
@@ -246,8 +314,12 @@ impl<const M: usize> Pipeline<M> {
     /// Drains the samples still in the delay line at the end of a recording, with the last
     /// stance decision, and returns the strides still held (at most two: one closed by the
     /// drained samples, one waiting for its following stance to end, or a gap stride still
-    /// open).
+    /// open). With [`Detector::PeakValley`] the first step still in flight; the others come
+    /// from [`Pipeline::take`].
     pub fn finish(&mut self) -> [Option<Stride>; 2] {
+        if self.detector == Detector::PeakValley {
+            return [self.take(), None];
+        }
         let first = self.drain().or_else(|| self.tracker.finish());
         let out = [
             first.map(|s| self.measure(s)),
@@ -256,6 +328,16 @@ impl<const M: usize> Pipeline<M> {
         self.since_reset = 0;
         self.stance_fed = 0;
         out
+    }
+
+    /// After [`Pipeline::finish`]: the next stride still held, until `None`. The stance
+    /// detector holds none beyond what `finish` returns; the peak-valley detector holds the
+    /// steps its look-ahead was waiting on (up to half its [`crate::peak_valley::EXTREMES_CAPACITY`]).
+    pub fn take(&mut self) -> Option<Stride> {
+        match self.detector {
+            Detector::Stance => None,
+            Detector::PeakValley => self.peaks.finish().map(|s| self.measure_step(s)),
+        }
     }
 
     /// Feeds the tracker the samples still in the delay line, with the last stance decision;
@@ -282,6 +364,31 @@ impl<const M: usize> Pipeline<M> {
         // Drained once: a second drain before new samples would feed them again.
         self.stance_fed = 0;
         closed
+    }
+
+    /// One of Lu's steps as a stride record, measured by Lu's chain.
+    #[inline(never)]
+    fn measure_step(&self, step: Step) -> Stride {
+        let mut flags = StrideFlags::PHASES_GUESSED;
+        if step.period == 0 {
+            flags |= StrideFlags::FROM_REST;
+        }
+        let um = models::lu_chain_um(&step, self.rate);
+        let mm = ((um.max(0) + 500) / 1000).min(u32::MAX as i64) as u32;
+        if mm > MAX_STRIDE_MM {
+            flags |= StrideFlags::IMPLAUSIBLE;
+        }
+        Stride {
+            index: step.index,
+            start: step.peak.index,
+            heel_off: step.peak.index,
+            toe_off: step.peak.index,
+            heel_strike: step.valley.index,
+            end: step.valley.index,
+            length_mm: mm.min(MAX_STRIDE_MM),
+            flags: StrideFlags(flags),
+            ..Stride::default()
+        }
     }
 
     /// Fills in the stride's length from the configured model; a malformed trained model
