@@ -324,6 +324,12 @@ pub struct Tally {
     pub contact: PhaseTally,
     /// Stance samples: (tp, fp, fn).
     pub stance: Option<(u64, u64, u64)>,
+    /// Detections overlapping the labelled span (Lu's `E`).
+    pub detected: usize,
+    /// Reference strides, flagged ones included (Lu's `T`).
+    pub references: usize,
+    /// Per trial, Lu's eq. 13 step-count error `|E − T| / T`.
+    pub count_errors: Vec<f64>,
 }
 
 /// Counts for one phase.
@@ -373,6 +379,9 @@ impl Tally {
         self.heel_strike_ms.extend_from_slice(&o.heel_strike_ms);
         self.swing.add(&o.swing);
         self.contact.add(&o.contact);
+        self.detected += o.detected;
+        self.references += o.references;
+        self.count_errors.extend_from_slice(&o.count_errors);
         self.stance = match (self.stance, o.stance) {
             (Some(a), Some(b)) => Some((a.0 + b.0, a.1 + b.1, a.2 + b.2)),
             (a, b) => a.or(b),
@@ -392,6 +401,14 @@ impl Tally {
     /// Stride F1.
     pub fn f1(&self) -> f64 {
         f1(self.tp as f64, self.fp as f64, self.fn_ as f64)
+    }
+
+    /// Lu's eq. 13 over the pooled counts: `|ΣE − ΣT| / ΣT`.
+    pub fn pooled_count_error(&self) -> f64 {
+        ratio(
+            (self.detected as f64 - self.references as f64).abs(),
+            self.references as f64,
+        )
     }
 
     /// Stance sample-wise F1, if labelled.
@@ -473,6 +490,12 @@ pub fn score(trial: &Trial, det: &[Detected], rate_hz: f64) -> Tally {
     let mut t = Tally {
         trials: 1,
         clean: refs.iter().filter(|r| !r.flagged).count(),
+        detected: det.len(),
+        references: refs.len(),
+        count_errors: vec![ratio(
+            (det.len() as f64 - refs.len() as f64).abs(),
+            refs.len() as f64,
+        )],
         ..Tally::default()
     };
     let mut matched_d = vec![None; det.len()];
@@ -772,6 +795,39 @@ pub fn table(results: &[DatasetResult]) -> String {
                 },
             );
         }
+    }
+    s
+}
+
+/// Step detection side by side: one row per dataset and detector (the `Tally` of each, as
+/// recorded), with Lu's eq. 13 step-count error as the mean over trials and pooled.
+pub fn detectors_table(rows: &[(&str, &str, &Tally)]) -> String {
+    let mut s = String::from(
+        "| dataset | detector | strides (all / clean) | detected | found | extra | missed | precision | recall | F1 | count error (eq. 13): mean of trials / pooled |\n|---|---|---|---|---|---|---|---|---|---|---|\n",
+    );
+    for (dataset, detector, t) in rows {
+        let pct = |v: f64| {
+            if v.is_nan() {
+                "–".to_string()
+            } else {
+                format!("{:.1} %", 100.0 * v)
+            }
+        };
+        let _ = writeln!(
+            s,
+            "| {dataset} | {detector} | {} / {} | {} | {} | {} | {} | {} | {} | {} | {} / {} |",
+            t.references,
+            t.clean,
+            t.detected,
+            t.tp,
+            t.fp,
+            t.fn_,
+            fmt3(t.precision()),
+            fmt3(t.recall()),
+            fmt3(t.f1()),
+            pct(mean(&t.count_errors)),
+            pct(t.pooled_count_error()),
+        );
     }
     s
 }

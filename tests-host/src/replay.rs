@@ -5,7 +5,7 @@ use std::collections::BTreeMap;
 
 use gaitclip::features::Features;
 use gaitclip::models::{self, Model};
-use gaitclip::pipeline::{Config, Pipeline};
+use gaitclip::pipeline::{Config, Detector, Pipeline};
 use gaitclip::rate::SampleRate;
 use gaitclip::sample::RawSample;
 use gaitclip::stride::{Stride, StrideFlags};
@@ -25,6 +25,15 @@ pub enum ReplayError {
     Time(#[from] crate::gaps::TimeError),
 }
 
+/// The name of the length behind a record: the configured model, or Lu's chain for the
+/// peak-valley detector (which measures its steps with nothing else).
+pub const fn length_name(detector: Detector, model: Model) -> &'static str {
+    match detector {
+        Detector::Stance => model.name(),
+        Detector::PeakValley => Model::LuFuzzy.name(),
+    }
+}
+
 /// A stride as the host reports it.
 #[derive(Clone, Debug, PartialEq, Serialize)]
 pub struct StrideReport {
@@ -38,6 +47,9 @@ pub struct StrideReport {
     pub length_m: f64,
     /// Name of the model behind `length_m`.
     pub model: &'static str,
+    /// The step detector (`stance`, or `lu`: then `heel_off_s`/`toe_off_s` are the step's
+    /// peak, `heel_strike_s`/`foot_flat_s` its valley).
+    pub detector: &'static str,
     /// Every model's length, m, by model name (`--all-models`).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub lengths_m: Option<BTreeMap<&'static str, f64>>,
@@ -122,6 +134,9 @@ pub fn core_strides_gapped(samples: &[RawSample], gaps: &[Gap], config: Config) 
         strides.extend(p.process(s));
     }
     strides.extend(p.finish().into_iter().flatten());
+    while let Some(s) = p.take() {
+        strides.push(s);
+    }
     strides
 }
 
@@ -147,20 +162,29 @@ pub fn replay_counts_with(
 ) -> Vec<StrideReport> {
     core_strides(samples, config)
         .into_iter()
-        .map(|s| report(s, config.model, &t_s))
+        .map(|s| report(s, config, &t_s))
         .collect()
 }
 
 /// Replays a trace in physical units with the default model.
 pub fn replay(trace: &Trace, ranges: Ranges) -> Result<Vec<StrideReport>, ReplayError> {
-    replay_model(trace, ranges, gaitclip::pipeline::DEFAULT_MODEL, false)
+    replay_model(
+        trace,
+        ranges,
+        Detector::Stance,
+        gaitclip::pipeline::DEFAULT_MODEL,
+        false,
+    )
 }
 
 /// Replays a trace in physical units: converts to counts at `ranges` (with saturation)
-/// first; `model` gives `length_m`, and with `all_models` every model's length is added.
+/// first; `detector` segments it, `model` gives `length_m` (the stance detector's strides;
+/// the peak-valley detector's steps are measured by Lu's chain), and with `all_models` every
+/// model's length is added (stance detector only: the models need its features).
 pub fn replay_model(
     trace: &Trace,
     ranges: Ranges,
+    detector: Detector,
     model: Model,
     all_models: bool,
 ) -> Result<Vec<StrideReport>, ReplayError> {
@@ -168,11 +192,12 @@ pub fn replay_model(
     let clock = GapClock::new(&trace.samples, &gaps, trace.rate_hz);
     let mut config = Config::new(rate, ranges.accel, ranges.gyro);
     config.model = model;
+    config.detector = detector;
     let mut out: Vec<StrideReport> = core_strides_gapped(&counts, &gaps, config)
         .into_iter()
-        .map(|s| report(s, config.model, &|n| clock.t_s(n)))
+        .map(|s| report(s, config, &|n| clock.t_s(n)))
         .collect();
-    if all_models {
+    if all_models && detector == Detector::Stance {
         for r in &mut out {
             if r.raw.flags.has(StrideFlags::GAP) {
                 // No length across a gap, from any model.
@@ -193,13 +218,14 @@ pub fn replay_model(
     Ok(out)
 }
 
-fn report(s: Stride, model: Model, t_s: &impl Fn(u32) -> f64) -> StrideReport {
+fn report(s: Stride, config: Config, t_s: &impl Fn(u32) -> f64) -> StrideReport {
     StrideReport {
         index: s.index,
         start_s: t_s(s.start),
         end_s: t_s(s.end),
         length_m: s.length_mm as f64 / 1000.0,
-        model: model.name(),
+        model: length_name(config.detector, config.model),
+        detector: config.detector.name(),
         lengths_m: None,
         zupt_m: s.zupt_um as f64 / 1e6,
         heel_off_s: t_s(s.heel_off),

@@ -6,7 +6,7 @@ use anyhow::Context;
 use clap::{Parser, Subcommand};
 use gaitclip::models::Model;
 use gaitclip::phases::PhaseMethod;
-use gaitclip::pipeline::Config;
+use gaitclip::pipeline::{Config, Detector};
 use gaitclip_host::eval::{self, Detected};
 use gaitclip_host::trace::{Ranges, Trace};
 use gaitclip_host::{csv_trace, fixtures, length_eval, mcap_io, replay, train};
@@ -34,10 +34,15 @@ enum Cmd {
         /// One JSON object per stride per line.
         #[arg(long)]
         json: bool,
-        /// Length model for `length_m` (default: the firmware's).
-        #[arg(long, value_name = "NAME", value_parser = model_names(), default_value = gaitclip::pipeline::DEFAULT_MODEL.name())]
-        model: String,
-        /// Add every model's length (`lengths_m` in JSON, a column each otherwise).
+        /// Step detector: `stance` (stance to stance, the firmware's default) or `lu` (Lu's
+        /// peak-valley detection, measured by Lu's chain: `--model lu_fuzzy`).
+        #[arg(long, value_name = "NAME", value_parser = detector_names(), default_value = Detector::Stance.name())]
+        detector: String,
+        /// Length model for `length_m` (default: the firmware's; `lu_fuzzy` with `--detector lu`).
+        #[arg(long, value_name = "NAME", value_parser = model_names())]
+        model: Option<String>,
+        /// Add every model's length (`lengths_m` in JSON, a column each otherwise; stance
+        /// detector only).
         #[arg(long)]
         all_models: bool,
         /// Also write the samples and the strides to this MCAP file (opens in Foxglove).
@@ -117,6 +122,10 @@ impl From<PhasesArg> for PhaseMethod {
     }
 }
 
+fn detector_names() -> clap::builder::PossibleValuesParser {
+    clap::builder::PossibleValuesParser::new(Detector::ALL.map(|d| d.name()))
+}
+
 fn model_names() -> clap::builder::PossibleValuesParser {
     clap::builder::PossibleValuesParser::new(Model::ALL.map(|m| m.name()))
 }
@@ -132,7 +141,14 @@ mod status {
     pub const INTERNAL: u8 = 70;
     /// An output file cannot be written.
     pub const CANT_WRITE: u8 = 74;
+    /// Options that do not go together.
+    pub const USAGE: u8 = 2;
 }
+
+/// Options that do not go together (exit status 2, as for clap's own usage errors).
+#[derive(Debug, thiserror::Error)]
+#[error("{0}")]
+struct UsageError(&'static str);
 
 /// Creating or writing an output file failed.
 #[derive(Debug, thiserror::Error)]
@@ -167,6 +183,9 @@ fn status_of(e: &anyhow::Error) -> u8 {
         if cause.is::<WriteError>() {
             return status::CANT_WRITE;
         }
+        if cause.is::<UsageError>() {
+            return status::USAGE;
+        }
     }
     status::INTERNAL
 }
@@ -181,6 +200,7 @@ fn main() -> ExitCode {
                 status::BAD_INPUT => "bad input",
                 status::NO_INPUT => "cannot read input",
                 status::CANT_WRITE => "cannot write output",
+                status::USAGE => "usage",
                 _ => "internal error",
             };
             eprintln!("gaitclip: {kind}: {e:#}");
@@ -206,13 +226,25 @@ fn run(cli: Cli) -> anyhow::Result<()> {
             trace,
             rate,
             json,
+            detector,
             model,
             all_models,
             mcap_out,
         } => {
+            let detector = Detector::from_name(&detector).context("unknown detector")?;
+            let model = match (detector, model.as_deref()) {
+                (_, Some(name)) => Model::from_name(name).context("unknown model")?,
+                (Detector::Stance, None) => gaitclip::pipeline::DEFAULT_MODEL,
+                (Detector::PeakValley, None) => Model::LuFuzzy,
+            };
+            if detector == Detector::PeakValley && (model != Model::LuFuzzy || all_models) {
+                return Err(UsageError(
+                    "the lu detector's steps are measured by Lu's own chain only: --model lu_fuzzy, without --all-models",
+                )
+                .into());
+            }
             let t = read_trace(&trace, rate)?;
-            let model = Model::from_name(&model).context("unknown model")?;
-            let strides = replay::replay_model(&t, Ranges::default(), model, all_models)
+            let strides = replay::replay_model(&t, Ranges::default(), detector, model, all_models)
                 .with_context(|| trace.display().to_string())?;
             for s in &strides {
                 if json {
@@ -255,24 +287,43 @@ fn run(cli: Cli) -> anyhow::Result<()> {
             phases,
             plots,
         } => {
-            let detector = |t: &Trace, r: Ranges| -> anyhow::Result<Vec<Detected>> {
-                let (counts, gaps, rate) = replay::prepare(t, r)?;
-                let mut config = Config::new(rate, r.accel, r.gyro);
-                config.phases = phases.into();
-                let clock = gaitclip_host::gaps::GapClock::new(&t.samples, &gaps, t.rate_hz);
-                Ok(replay::core_strides_gapped(&counts, &gaps, config)
-                    .iter()
-                    .map(|s| Detected::from(s).map(|n| clock.recording_index(n)))
-                    .collect())
+            let run_with = |which: Detector| {
+                move |t: &Trace, r: Ranges| -> anyhow::Result<Vec<Detected>> {
+                    let (counts, gaps, rate) = replay::prepare(t, r)?;
+                    let mut config = Config::new(rate, r.accel, r.gyro);
+                    config.phases = phases.into();
+                    config.detector = which;
+                    let clock = gaitclip_host::gaps::GapClock::new(&t.samples, &gaps, t.rate_hz);
+                    Ok(replay::core_strides_gapped(&counts, &gaps, config)
+                        .iter()
+                        .map(|s| Detected::from(s).map(|n| clock.recording_index(n)))
+                        .collect())
+                }
             };
+            let (stance, lu) = (run_with(Detector::Stance), run_with(Detector::PeakValley));
             let mut results = Vec::new();
+            let mut side_by_side = Vec::new();
             let mut runs = Vec::new();
             for dir in &datasets {
                 let d = eval::load(dir)?;
-                results.push(eval::evaluate(&d, &detector, rotate, seed)?);
+                let by_stance = eval::evaluate(&d, &stance, rotate, seed)?;
+                let by_lu = eval::evaluate(&d, &lu, 0, seed)?;
+                side_by_side.push((d.name.clone(), by_stance.tally.clone(), by_lu.tally));
+                results.push(by_stance);
                 runs.extend(train::run_dataset(&d)?);
             }
             print!("{}", eval::table(&results));
+            let rows: Vec<(&str, &str, &eval::Tally)> = side_by_side
+                .iter()
+                .flat_map(|(name, s, l)| {
+                    [
+                        (name.as_str(), Detector::Stance.name(), s),
+                        (name.as_str(), Detector::PeakValley.name(), l),
+                    ]
+                })
+                .collect();
+            println!("\nStep detectors side by side (stance: the table above; lu: Lu's peak-valley detection):\n");
+            print!("{}", eval::detectors_table(&rows));
             let hyper = train::hyper_from(&gaitclip::trained::HYPER);
             let (pred, _) = length_eval::cross_validate(&runs, &hyper)?;
             println!();
