@@ -129,6 +129,18 @@ const fn log2_nearest(n: u32) -> u32 {
     }
 }
 
+/// The step detector's state. A pipeline runs one detector for its life, so the two share
+/// their memory: the peak-valley detector costs no RAM on a board that uses the stance one.
+#[derive(Clone, Debug)]
+#[allow(clippy::large_enum_variant)] // sharing the memory is the point
+enum Segmenter<const M: usize> {
+    Stance {
+        stance: StanceDetector,
+        tracker: StrideTracker<M>,
+    },
+    PeakValley(PeakValleyDetector),
+}
+
 /// From raw samples to strides, with a movement buffer of `M` samples
 /// ([`MAX_MOVEMENT_SAMPLES`] by default, 6 KiB; see [`Pipeline::sized`]).
 #[derive(Clone, Debug)]
@@ -136,10 +148,9 @@ pub struct Pipeline<const M: usize = MAX_MOVEMENT_SAMPLES> {
     filter: MeanFilter<MEAN_FILTER_CAPACITY>,
     rest: RestDetector,
     frame: FootFrameEstimator,
-    stance: StanceDetector,
-    tracker: StrideTracker<M>,
-    detector: Detector,
-    peaks: PeakValleyDetector,
+    segmenter: Segmenter<M>,
+    /// The stance detector's delay (0 with the peak-valley detector).
+    stance_delay: u32,
     rate: SampleRate,
     model: Model,
     settings: Settings,
@@ -182,10 +193,17 @@ impl<const M: usize> Pipeline<M> {
             filter,
             rest,
             frame: FootFrameEstimator::new(config.rate, config.accel),
-            stance,
-            tracker: StrideTracker::sized(config.rate, config.gyro, config.phases),
-            detector: config.detector,
-            peaks: PeakValleyDetector::new(config.rate),
+            stance_delay: match config.detector {
+                Detector::Stance => stance.delay(),
+                Detector::PeakValley => 0,
+            },
+            segmenter: match config.detector {
+                Detector::Stance => Segmenter::Stance {
+                    stance,
+                    tracker: StrideTracker::sized(config.rate, config.gyro, config.phases),
+                },
+                Detector::PeakValley => Segmenter::PeakValley(PeakValleyDetector::new(config.rate)),
+            },
             rate: config.rate,
             model: config.model,
             settings: config.settings,
@@ -245,25 +263,26 @@ impl<const M: usize> Pipeline<M> {
         }
         let frame = self.frame.frame()?;
         let foot = frame.apply(filtered);
-        if self.detector == Detector::PeakValley {
-            // The filtered value is the mean of a window centred `delay` samples back.
-            let at = index.wrapping_sub(self.filter.delay());
-            return self
-                .peaks
-                .process(at, foot[2])
-                .map(|s| self.measure_step(s));
-        }
+        let (stance, tracker) = match &mut self.segmenter {
+            Segmenter::Stance { stance, tracker } => (stance, tracker),
+            Segmenter::PeakValley(peaks) => {
+                // The filtered value is the mean of a window centred `delay` samples back.
+                let at = index.wrapping_sub(self.filter.delay());
+                let step = peaks.process(at, foot[2]);
+                return step.map(|s| self.measure_step(s));
+            }
+        };
         self.foot_line[slot(index)] = foot;
-        let decision = self.stance.process(foot, s.gyro)?;
+        let decision = stance.process(foot, s.gyro)?;
         self.stance_fed = self.stance_fed.saturating_add(1);
         self.last_decision = decision;
         if self.since_reset <= self.delay {
             return None;
         }
         let at = index.wrapping_sub(self.delay);
-        let foot_at = index.wrapping_sub(self.stance.delay());
+        let foot_at = index.wrapping_sub(self.stance_delay);
         let (raw, foot) = (self.raw_line[slot(at)], self.foot_line[slot(foot_at)]);
-        let stride = self.tracker.process(at, &raw, foot, decision);
+        let stride = tracker.process(at, &raw, foot, decision);
         stride.map(|s| self.measure(s))
     }
 
@@ -273,31 +292,31 @@ impl<const M: usize> Pipeline<M> {
     /// [`crate::stride::StrideFlags::GAP`] stride (no length, reported once the next stance
     /// is found after the gap), and detection restarts after it. Returns the stride the drain
     /// let the tracker report or that it held, complete and measured as usual.
-    // Not inlined: its strides would otherwise sit in the caller's frame on the sample path.
     ///
     /// With [`Detector::PeakValley`] the steps in flight are decided as at the end of a
     /// recording and come out of the next calls to [`Pipeline::process`].
+    // Not inlined: its strides would otherwise sit in the caller's frame on the sample path.
     #[inline(never)]
     pub fn gap(&mut self, missing: u32) -> Option<Stride> {
-        if self.detector == Detector::PeakValley {
-            self.peaks.gap();
-            self.next = self.next.wrapping_add(missing);
-            self.since_reset = 0;
-            self.filter = MeanFilter::with_len_log2(self.filter.window().trailing_zeros());
-            self.rest.reset();
-            self.frame.gap();
-            return None;
-        }
         // The drain runs on one stance decision, so it makes one transition at most, and
         // then the tracker holds nothing to hand back; should both ever carry a stride, the
         // later one stays held (reported after the gap), so nothing is lost.
         let drained = self.drain();
-        let out = match (drained, self.tracker.gap()) {
-            (Some(a), Some(b)) => {
-                self.tracker.hold(b);
-                Some(a)
+        let out = match &mut self.segmenter {
+            Segmenter::Stance { stance, tracker } => {
+                stance.reset();
+                match (drained, tracker.gap()) {
+                    (Some(a), Some(b)) => {
+                        tracker.hold(b);
+                        Some(a)
+                    }
+                    (a, b) => a.or(b),
+                }
             }
-            (a, b) => a.or(b),
+            Segmenter::PeakValley(peaks) => {
+                peaks.gap();
+                None
+            }
         };
         self.next = self.next.wrapping_add(missing);
         self.since_reset = 0;
@@ -305,7 +324,6 @@ impl<const M: usize> Pipeline<M> {
         self.filter = MeanFilter::with_len_log2(self.filter.window().trailing_zeros());
         self.rest.reset();
         self.frame.gap();
-        self.stance.reset();
         // Measured last and once: a single stride on this frame while the models run keeps
         // the gap path's stack no deeper than a sample's.
         out.map(|s| self.measure(s))
@@ -317,13 +335,15 @@ impl<const M: usize> Pipeline<M> {
     /// open). With [`Detector::PeakValley`] the first step still in flight; the others come
     /// from [`Pipeline::take`].
     pub fn finish(&mut self) -> [Option<Stride>; 2] {
-        if self.detector == Detector::PeakValley {
+        let drained = self.drain();
+        let Segmenter::Stance { tracker, .. } = &mut self.segmenter else {
             return [self.take(), None];
-        }
-        let first = self.drain().or_else(|| self.tracker.finish());
+        };
+        let first = drained.or_else(|| tracker.finish());
+        let second = tracker.finish();
         let out = [
             first.map(|s| self.measure(s)),
-            self.tracker.finish().map(|s| self.measure(s)),
+            second.map(|s| self.measure(s)),
         ];
         self.since_reset = 0;
         self.stance_fed = 0;
@@ -334,9 +354,12 @@ impl<const M: usize> Pipeline<M> {
     /// detector holds none beyond what `finish` returns; the peak-valley detector holds the
     /// steps its look-ahead was waiting on (up to half its [`crate::peak_valley::EXTREMES_CAPACITY`]).
     pub fn take(&mut self) -> Option<Stride> {
-        match self.detector {
-            Detector::Stance => None,
-            Detector::PeakValley => self.peaks.finish().map(|s| self.measure_step(s)),
+        match &mut self.segmenter {
+            Segmenter::Stance { .. } => None,
+            Segmenter::PeakValley(peaks) => {
+                let step = peaks.finish();
+                step.map(|s| self.measure_step(s))
+            }
         }
     }
 
@@ -344,20 +367,23 @@ impl<const M: usize> Pipeline<M> {
     /// returns the stride they let it report, if any, not yet measured.
     fn drain(&mut self) -> Option<Stride> {
         let mut closed = None;
+        let Segmenter::Stance { tracker, .. } = &mut self.segmenter else {
+            return None;
+        };
         // The tracker has had samples up to `next − 1 − delay`; the foot-frame values reach
         // `next − 1 − filter delay`, so that many more can be drained.
         let fd = self.filter.delay();
         let pending = if self.stance_fed == 0 {
             0
         } else {
-            self.stance.delay()
+            self.stance_delay
         };
         let slot = |i: u32| i as usize & (DELAY_CAPACITY - 1);
         for k in (0..pending).rev() {
             let at = self.next.wrapping_sub(1 + fd).wrapping_sub(k);
             let foot_at = at.wrapping_add(fd);
             let (raw, foot) = (self.raw_line[slot(at)], self.foot_line[slot(foot_at)]);
-            if let Some(st) = self.tracker.process(at, &raw, foot, self.last_decision) {
+            if let Some(st) = tracker.process(at, &raw, foot, self.last_decision) {
                 closed = Some(st);
             }
         }
