@@ -12,6 +12,7 @@
 //! 1. **Low-pass** ([`crate::low_pass`]): −3 dB at 3 Hz at every sample rate.
 //! 2. **Extremes**: a peak is a local maximum above zero, a valley a local minimum below
 //!    zero (negative peaks and positive valleys are ignored); on a plateau, its last sample.
+//!    None is taken in the filter's first delay after a start or a gap (it is settling).
 //! 3. **Static** (eq. 2): a peak whose running mean with the next two peaks is below
 //!    [`STATIC_G`] (0.01 g) is the sensor at rest and is removed; valleys likewise above
 //!    −0.01 g.
@@ -236,6 +237,8 @@ pub struct PeakValleyDetector {
     min_interval: u32,
     // Extreme finder.
     started: bool,
+    /// Extremes before this sample number are the filter settling from its first input.
+    settled_at: u32,
     last: i32,
     direction: i8,
     candidate: Extreme,
@@ -279,6 +282,7 @@ impl PeakValleyDetector {
             dynamic_lookahead: rate.samples_in_ms(DYNAMIC_LOOKAHEAD_MS),
             min_interval: rate.samples_in_ms(MIN_INTERVAL_MS),
             started: false,
+            settled_at: 0,
             last: 0,
             direction: 0,
             candidate: unknown,
@@ -316,6 +320,14 @@ impl PeakValleyDetector {
     /// calls, except across [`PeakValleyDetector::finish`].
     pub fn process(&mut self, index: u32, vertical: i16) -> Option<Step> {
         let y = self.filter.process(vertical);
+        self.process_filtered(index, y)
+    }
+
+    /// [`PeakValleyDetector::process`] after the low-pass: `y` is the filtered vertical
+    /// acceleration, g/32 768. The steps' sample numbers still have
+    /// [`PeakValleyDetector::filter_delay`] taken off. For tests of the rules on hand-made
+    /// signals, and for a caller with its own filter.
+    pub fn process_filtered(&mut self, index: u32, y: i32) -> Option<Step> {
         let found = self.find(index, y);
         if let Some(e) = found {
             let x = InFlight {
@@ -365,6 +377,7 @@ impl PeakValleyDetector {
     fn find(&mut self, index: u32, y: i32) -> Option<Extreme> {
         if !self.started {
             self.started = true;
+            self.settled_at = index.wrapping_add(self.delay);
             self.last = y;
             self.direction = 0;
             self.candidate = Extreme {
@@ -391,6 +404,11 @@ impl PeakValleyDetector {
                 });
             }
             self.direction = -1;
+        }
+        if out.is_some_and(|e| !reached(e.index, self.settled_at)) {
+            // Before the filter's delay has passed, an extreme would be dated before the
+            // first sample; the filter is still settling from it.
+            out = None;
         }
         // The newest sample is the candidate: the extreme of a run is its last sample, so
         // no extreme still to come lies before it (the watermark the rules wait on).
