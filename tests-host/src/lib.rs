@@ -13,6 +13,7 @@ pub mod gaps;
 pub mod length_eval;
 pub mod length_ref;
 pub mod mcap_io;
+pub mod peak_valley_ref;
 pub mod qemu;
 pub mod reference;
 pub mod replay;
