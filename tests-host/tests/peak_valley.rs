@@ -258,8 +258,8 @@ fn vertical(path: &std::path::Path, rate_hz: f64) -> (Vec<i16>, Vec<f64>) {
     let n = t.samples.len() as f64;
     let mut up = [0.0; 3];
     for s in &t.samples {
-        for k in 0..3 {
-            up[k] += s.acc_mps2[k] / n;
+        for (u, a) in up.iter_mut().zip(s.acc_mps2) {
+            *u += a / n;
         }
     }
     let norm = up.iter().map(|v| v * v).sum::<f64>().sqrt();
