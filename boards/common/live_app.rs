@@ -14,7 +14,9 @@ use cortex_m::interrupt::{self as irq, Mutex};
 use embedded_hal::delay::DelayNs;
 use embedded_hal::i2c::I2c;
 use gaitclip::mpu6050::{self, Mpu6050};
-use gaitclip::pipeline::Pipeline;
+use gaitclip::pipeline::{Config, Detector, Pipeline};
+use gaitclip::rate::SampleRate;
+use gaitclip::sample::{AccelRange, GyroRange};
 use heapless::spsc::{Consumer, Producer};
 
 use crate::imu_sampler::{BusRecovery, Counters, ImuSampler, Item, ReadMode};
@@ -24,6 +26,22 @@ use crate::stride_log::StrideLog;
 
 /// Interval of the status line.
 pub const STATUS_EVERY_MS: u32 = 60_000;
+
+/// The firmware's step detector: stance to stance, unless the board is built with the
+/// `peak-valley-detector` feature (Lu's detection and chain; see `gaitclip::pipeline`).
+pub const DETECTOR: Detector = if cfg!(feature = "peak-valley-detector") {
+    Detector::PeakValley
+} else {
+    Detector::Stance
+};
+
+/// The pipeline's configuration for samples at `rate` in the given ranges, with the
+/// firmware's [`DETECTOR`].
+pub const fn config(rate: SampleRate, accel: AccelRange, gyro: GyroRange) -> Config {
+    let mut c = Config::new(rate, accel, gyro);
+    c.detector = DETECTOR;
+    c
+}
 /// Period of the board's watchdog timer.
 pub const WATCHDOG_TICK_MS: u32 = 100;
 /// Watchdog ticks without a data-ready pulse after which the sensor is declared silent.

@@ -44,7 +44,7 @@ pub const RATE: SampleRate = unwrap(SampleRate::from_millihertz(trace::RATE_MILL
 const ACCEL: AccelRange = unwrap(AccelRange::from_afs_sel(trace::ACCEL_AFS_SEL));
 const GYRO: GyroRange = unwrap(GyroRange::from_fs_sel(trace::GYRO_FS_SEL));
 /// The pipeline's configuration for the stored trace.
-pub const CONFIG: Config = Config::new(RATE, ACCEL, GYRO);
+pub const CONFIG: Config = crate::live_app::config(RATE, ACCEL, GYRO);
 const SENSOR: mpu6050::Config = mpu6050::Config {
     rate: unwrap(mpu6050::OutputRate::from_hz(
         (trace::RATE_MILLIHERTZ / 1000) as u16,
@@ -118,7 +118,7 @@ pub fn run<const M: usize>(
         }
     };
     let mut log = StrideLog::new(RATE);
-    log.banner(board, CONFIG.model, &mut NoSerial);
+    log.banner(board, &CONFIG, &mut NoSerial);
     defmt::info!(
         "replaying {=u32} samples of the stored trace through the emulated MPU6050",
         TRACE_SAMPLES
@@ -192,6 +192,9 @@ fn finish<const M: usize>(pipeline: &mut Pipeline<M>, log: &mut StrideLog, sampl
     let serial = &mut NoSerial;
     for stride in pipeline.finish().iter().flatten() {
         log.stride(stride, serial);
+    }
+    while let Some(stride) = pipeline.take() {
+        log.stride(&stride, serial);
     }
     log.summary(samples, &LINK.counters(), serial);
     let (used, size) = crate::stack_paint::used_and_size();

@@ -5,7 +5,7 @@
 //! every other line is CSV under the header line that follows the banner:
 //!
 //! ```text
-//! # gaitclip 0.1.0 board=nrf52840-dk rate_mhz=200000 model=huang_svr_fusion
+//! # gaitclip 0.1.0 board=nrf52840-dk rate_mhz=200000 detector=stance model=huang_svr_fusion
 //! index,t_ms,length_mm,duration_ms,stance_ms,push_off_ms,swing_ms,heel_strike_ms,climb_mm,flags,valid
 //! # hold still: waiting for the clip to rest (2 s)
 //! # still: gyro_bias_mdps=-1220,305,61 gravity_mg=1003
@@ -24,6 +24,7 @@
 use core::fmt::{self, Write};
 
 use gaitclip::models::Model;
+use gaitclip::pipeline::Detector;
 use gaitclip::rate::SampleRate;
 use gaitclip::stride::Stride;
 
@@ -37,13 +38,20 @@ pub const MAX_LINE: usize = 256;
 pub const HEADER: &str = "index,t_ms,length_mm,duration_ms,stance_ms,push_off_ms,swing_ms,heel_strike_ms,climb_mm,flags,valid";
 
 /// The banner and the CSV header.
-pub fn banner(out: &mut impl Write, board: &str, rate: SampleRate, model: Model) -> fmt::Result {
+pub fn banner(
+    out: &mut impl Write,
+    board: &str,
+    rate: SampleRate,
+    detector: Detector,
+    model: Model,
+) -> fmt::Result {
     write!(
         out,
-        "# gaitclip {} board={} rate_mhz={} model={}\r\n{}\r\n",
+        "# gaitclip {} board={} rate_mhz={} detector={} model={}\r\n{}\r\n",
         env!("CARGO_PKG_VERSION"),
         board,
         rate.millihertz(),
+        detector.name(),
         model.name(),
         HEADER
     )

@@ -8,6 +8,7 @@
 use core::fmt::Write;
 
 use gaitclip::models::Model;
+use gaitclip::pipeline::{Config, Detector};
 use gaitclip::rate::SampleRate;
 use gaitclip::stride::Stride;
 
@@ -41,16 +42,22 @@ impl StrideLog {
         }
     }
 
-    /// The banner of the serial protocol (defmt logs its own).
-    pub fn banner(&self, board: &str, model: Model, serial: &mut impl Write) {
+    /// The banner of the serial protocol (defmt logs its own): the detector, and the model
+    /// behind the lengths (Lu's chain with the peak-valley detector, whatever `config.model`).
+    pub fn banner(&self, board: &str, config: &Config, serial: &mut impl Write) {
+        let model = match config.detector {
+            Detector::Stance => config.model,
+            Detector::PeakValley => Model::LuFuzzy,
+        };
         defmt::info!(
-            "gaitclip {=str} on {=str}: {=u32} mHz, model {=str}",
+            "gaitclip {=str} on {=str}: {=u32} mHz, detector {=str}, model {=str}",
             env!("CARGO_PKG_VERSION"),
             board,
             self.rate.millihertz(),
+            config.detector.name(),
             model.name()
         );
-        let _ = serial_line::banner(serial, board, self.rate, model);
+        let _ = serial_line::banner(serial, board, self.rate, config.detector, model);
     }
 
     /// Logs one stride.

@@ -42,7 +42,7 @@ use defmt_rtt as _;
 use embedded_hal::delay::DelayNs;
 use embedded_hal::i2c::{ErrorType, I2c, Operation, SevenBitAddress};
 use gaitclip::mpu6050::{self, Address, Mpu6050, OutputRate};
-use gaitclip::pipeline::{Config, Pipeline};
+use gaitclip::pipeline::Pipeline;
 use gaitclip::rate::SampleRate;
 use gaitclip::sample::{AccelRange, GyroRange};
 use gaitclip::stride::MAX_MOVEMENT_SAMPLES;
@@ -153,7 +153,7 @@ type WatchdogTimer = Timer<TIMER1, Periodic>;
 static WATCHDOG: Mutex<RefCell<Option<(WatchdogTimer, Watchdog)>>> = Mutex::new(RefCell::new(None));
 static QUEUE: ConstStaticCell<Queue<Item, QUEUE_LEN>> = ConstStaticCell::new(Queue::new());
 static PIPELINE: ConstStaticCell<Pipeline<MAX_MOVEMENT_SAMPLES>> =
-    ConstStaticCell::new(Pipeline::sized(Config::new(RATE, ACCEL, GYRO)));
+    ConstStaticCell::new(Pipeline::sized(live_app::config(RATE, ACCEL, GYRO)));
 
 #[entry]
 fn main() -> ! {
@@ -177,7 +177,7 @@ fn main() -> ! {
     let mut log = StrideLog::new(RATE);
     log.banner(
         "nrf52840-dk",
-        gaitclip::pipeline::DEFAULT_MODEL,
+        &live_app::config(RATE, ACCEL, GYRO),
         &mut serial,
     );
 

@@ -41,7 +41,7 @@ use embedded_hal::digital::OutputPin;
 use embedded_hal::i2c::{ErrorType, I2c, Operation, SevenBitAddress};
 use fugit::{HertzU32, RateExtU32};
 use gaitclip::mpu6050::{self, Address, Mpu6050, OutputRate};
-use gaitclip::pipeline::{Config, Pipeline};
+use gaitclip::pipeline::Pipeline;
 use gaitclip::rate::SampleRate;
 use gaitclip::sample::{AccelRange, GyroRange};
 use gaitclip::stride::MAX_MOVEMENT_SAMPLES;
@@ -168,7 +168,7 @@ static INT_PIN: Mutex<RefCell<Option<IntPin>>> = Mutex::new(RefCell::new(None));
 static WATCHDOG: Mutex<RefCell<Option<(Alarm0, SensorWatchdog)>>> = Mutex::new(RefCell::new(None));
 static QUEUE: ConstStaticCell<Queue<Item, QUEUE_LEN>> = ConstStaticCell::new(Queue::new());
 static PIPELINE: ConstStaticCell<Pipeline<MAX_MOVEMENT_SAMPLES>> =
-    ConstStaticCell::new(Pipeline::sized(Config::new(RATE, ACCEL, GYRO)));
+    ConstStaticCell::new(Pipeline::sized(live_app::config(RATE, ACCEL, GYRO)));
 
 #[hal::entry]
 fn main() -> ! {
@@ -206,7 +206,7 @@ fn main() -> ! {
         panic!("UART0 did not start");
     };
     let mut log = StrideLog::new(RATE);
-    log.banner("rp-pico", gaitclip::pipeline::DEFAULT_MODEL, &mut serial);
+    log.banner("rp-pico", &live_app::config(RATE, ACCEL, GYRO), &mut serial);
 
     let sda: Sda = pins.gpio4.reconfigure();
     let scl: Scl = pins.gpio5.reconfigure();

@@ -18,7 +18,8 @@ pub fn build_in(dir: &str, bin: &str, target: &str) -> anyhow::Result<PathBuf> {
     build_with(dir, bin, target, &[], &[])
 }
 
-/// [`build_in`] with extra cargo arguments (`--features …`) and environment variables.
+/// [`build_in`] with extra cargo arguments (`--features …`) and environment variables (a
+/// `CARGO_TARGET_DIR` among them, relative to `dir`, keeps a variant's ELF apart).
 pub fn build_with(
     dir: &str,
     bin: &str,
@@ -41,7 +42,11 @@ pub fn build_with(
     if !status.success() {
         bail!("firmware build failed ({status})");
     }
-    Ok(root.join("target").join(target).join("release").join(bin))
+    let target_dir = env
+        .iter()
+        .find(|(k, _)| *k == "CARGO_TARGET_DIR")
+        .map_or_else(|| root.join("target"), |(_, v)| root.join(v));
+    Ok(target_dir.join(target).join("release").join(bin))
 }
 
 /// Builds `bin` of the top-level crate for `target`; see [`build_in`].

@@ -3,15 +3,22 @@
 //! fixture from flash through the emulated sensor bus and the real driver, logs the same
 //! per-stride integers as the host replay of the same fixture.
 
+use gaitclip::pipeline::{Config, Detector};
 use gaitclip::rate::SampleRate;
 use gaitclip_host::firmware::{self, parse_stride_line, LoggedStride};
 use gaitclip_host::qemu::{self, RunOptions};
-use gaitclip_host::replay::replay_counts;
+use gaitclip_host::replay::replay_counts_with;
 use gaitclip_host::trace::Ranges;
 
 #[test]
 fn qemu_m4_strides_equal_host_replay() {
-    strides_equal_host_replay(".", "mps2-an386", "thumbv7em-none-eabihf", qemu::MACHINE_M4);
+    strides_equal_host_replay(
+        ".",
+        "mps2-an386",
+        "thumbv7em-none-eabihf",
+        qemu::MACHINE_M4,
+        Detector::Stance,
+    );
 }
 
 #[test]
@@ -21,14 +28,43 @@ fn qemu_m0_strides_equal_host_replay() {
         "microbit",
         "thumbv6m-none-eabi",
         qemu::MACHINE_M0,
+        Detector::Stance,
     );
 }
 
-fn strides_equal_host_replay(dir: &str, bin: &str, target: &str, machine: &str) {
+/// The firmware built with the `peak-valley-detector` setting, on the smallest board.
+#[test]
+fn qemu_m0_peak_valley_steps_equal_host_replay() {
+    strides_equal_host_replay(
+        "boards/microbit",
+        "microbit",
+        "thumbv6m-none-eabi",
+        qemu::MACHINE_M0,
+        Detector::PeakValley,
+    );
+}
+
+fn strides_equal_host_replay(
+    dir: &str,
+    bin: &str,
+    target: &str,
+    machine: &str,
+    detector: Detector,
+) {
     if !qemu::available_or_skip() {
         return;
     }
-    let elf = firmware::build_in(dir, bin, target).expect("firmware builds");
+    let elf = match detector {
+        Detector::Stance => firmware::build_in(dir, bin, target),
+        Detector::PeakValley => firmware::build_with(
+            dir,
+            bin,
+            target,
+            &["--features", "peak-valley-detector"],
+            &[("CARGO_TARGET_DIR", "target/peak-valley".as_ref())],
+        ),
+    }
+    .expect("firmware builds");
     let out = qemu::run(
         &elf,
         &RunOptions {
@@ -52,27 +88,25 @@ fn strides_equal_host_replay(dir: &str, bin: &str, target: &str, machine: &str) 
         .collect();
 
     let counts = gaitclip_host::fixtures::firmware_trace_counts().unwrap();
-    let host: Vec<LoggedStride> = replay_counts(
-        &counts,
-        SampleRate::from_hz(200).unwrap(),
-        Ranges::default(),
-        |i| i as f64,
-    )
-    .iter()
-    .map(|s| LoggedStride {
-        index: s.raw.index,
-        idx: [
-            s.raw.start,
-            s.raw.heel_off,
-            s.raw.toe_off,
-            s.raw.heel_strike,
-            s.raw.end,
-        ],
-        length_mm: s.raw.length_mm,
-        climb_mm: s.raw.climb_mm,
-        flags: s.raw.flags.0,
-    })
-    .collect();
+    let ranges = Ranges::default();
+    let mut config = Config::new(SampleRate::from_hz(200).unwrap(), ranges.accel, ranges.gyro);
+    config.detector = detector;
+    let host: Vec<LoggedStride> = replay_counts_with(&counts, config, |i| i as f64)
+        .iter()
+        .map(|s| LoggedStride {
+            index: s.raw.index,
+            idx: [
+                s.raw.start,
+                s.raw.heel_off,
+                s.raw.toe_off,
+                s.raw.heel_strike,
+                s.raw.end,
+            ],
+            length_mm: s.raw.length_mm,
+            climb_mm: s.raw.climb_mm,
+            flags: s.raw.flags.0,
+        })
+        .collect();
     assert!(host.len() >= 20, "host found {} strides", host.len());
     assert_eq!(on_target, host);
 
