@@ -27,7 +27,9 @@
 //!    `gaitclip train` writes into [`trained`]; the pipeline's model fills in the length.
 //!
 //! [`pipeline::Pipeline`] composes them; a board or a host tool only feeds samples and
-//! reads strides.
+//! reads strides. In place of stages 4–5 it can run Lu's [`peak_valley`] detector on the
+//! vertical acceleration (after the [`low_pass`]), whose steps Lu's own chain measures
+//! ([`pipeline::Detector`]); the stance detector is the default.
 //!
 //! **Integer on the sample path.** The per-sample work is integer arithmetic with documented
 //! scaling ([`fixed`]): Q30 quaternions, counts·2⁸ accelerations, `i64` integrals. The same
