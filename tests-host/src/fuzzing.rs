@@ -5,7 +5,7 @@
 use std::path::Path;
 
 use gaitclip::models::Model;
-use gaitclip::pipeline::{Config, Pipeline};
+use gaitclip::pipeline::{Config, Detector, Pipeline};
 use gaitclip::rate::SampleRate;
 use gaitclip::sample::{AccelRange, GyroRange, RawSample};
 use gaitclip::stride::{StrideFlags, MAX_STRIDE_MM};
@@ -70,8 +70,9 @@ fn check_reports(strides: &[StrideReport]) {
 }
 
 /// Arbitrary bytes as a run of the core: byte 0 picks the rate (100–1020 Hz in steps of
-/// 4), byte 1 the length model; then 13-byte records: a control byte (≥ 0xF0: a gap of
-/// `(c & 0x0F) × 37` samples before the sample) and six big-endian i16 (accel, gyro).
+/// 4), byte 1 the detector (high bit: peak-valley) and the length model; then 13-byte
+/// records: a control byte (≥ 0xF0: a gap of `(c & 0x0F) × 37` samples before the sample)
+/// and six big-endian i16 (accel, gyro).
 /// Every stride must be well formed: events in order, inside what was fed, lengths bounded,
 /// none across a gap with a length.
 pub fn core_pipeline(data: &[u8]) {
@@ -82,7 +83,11 @@ pub fn core_pipeline(data: &[u8]) {
         return;
     };
     let mut config = Config::new(rate, AccelRange::G16, GyroRange::Dps2000);
-    config.model = Model::ALL[*model_b as usize % Model::ALL.len()];
+    // The high bit picks the detector, the rest the model.
+    config.model = Model::ALL[(*model_b & 0x7F) as usize % Model::ALL.len()];
+    if *model_b & 0x80 != 0 {
+        config.detector = Detector::PeakValley;
+    }
     let mut p = Pipeline::new(config);
     let mut strides = Vec::new();
     for rec in rest.chunks_exact(13) {
@@ -98,6 +103,9 @@ pub fn core_pipeline(data: &[u8]) {
         strides.extend(p.process(&s));
     }
     strides.extend(p.finish().into_iter().flatten());
+    while let Some(s) = p.take() {
+        strides.push(s);
+    }
     for (k, s) in strides.iter().enumerate() {
         assert!(s.start <= s.heel_off && s.heel_off <= s.toe_off, "{s:?}");
         assert!(
