@@ -710,6 +710,19 @@ fn fmt_ms(v: &[f64]) -> String {
     }
 }
 
+/// The cells `found | extra | missed | precision | recall | F1` of a tally.
+fn detection_cells(t: &Tally) -> String {
+    format!(
+        "{} | {} | {} | {} | {} | {}",
+        t.tp,
+        t.fp,
+        t.fn_,
+        fmt3(t.precision()),
+        fmt3(t.recall()),
+        fmt3(t.f1())
+    )
+}
+
 fn phase_cell(p: &PhaseTally) -> String {
     if p.labelled {
         format!("{} / {}", fmt3(p.f_score()), fmt3(p.mean_iou()))
@@ -726,15 +739,10 @@ pub fn table(results: &[DatasetResult]) -> String {
     let row = |s: &mut String, name: &str, t: &Tally| {
         let _ = writeln!(
             s,
-            "| {name} | {} | {} | {} | {} | {} | {} | {} | {} | {} | {} | {} | {} | {} |",
+            "| {name} | {} | {} | {} | {} | {} | {} | {} | {} |",
             t.trials,
             t.clean,
-            t.tp,
-            t.fp,
-            t.fn_,
-            fmt3(t.precision()),
-            fmt3(t.recall()),
-            fmt3(t.f1()),
+            detection_cells(t),
             fmt_ms(&t.toe_off_ms),
             fmt_ms(&t.heel_strike_ms),
             phase_cell(&t.swing),
@@ -815,16 +823,11 @@ pub fn detectors_table(rows: &[(&str, &str, &Tally)]) -> String {
         };
         let _ = writeln!(
             s,
-            "| {dataset} | {detector} | {} / {} | {} | {} | {} | {} | {} | {} | {} | {} / {} |",
+            "| {dataset} | {detector} | {} / {} | {} | {} | {} / {} |",
             t.references,
             t.clean,
             t.detected,
-            t.tp,
-            t.fp,
-            t.fn_,
-            fmt3(t.precision()),
-            fmt3(t.recall()),
-            fmt3(t.f1()),
+            detection_cells(t),
             pct(mean(&t.count_errors)),
             pct(t.pooled_count_error()),
         );
