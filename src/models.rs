@@ -285,8 +285,18 @@ pub fn predict_mm(
     settings: Settings,
     params: &ModelParams,
 ) -> Option<u32> {
-    let um = predict_um(model, f, settings, params)?;
-    Some(((um.max(0) + 500) / 1000).min(u32::MAX as i64) as u32)
+    predict_um(model, f, settings, params).map(um_to_mm)
+}
+
+/// A length in µm as whole mm: clamped at 0, rounded, saturated at `u32::MAX`.
+pub const fn um_to_mm(um: i64) -> u32 {
+    let um = if um < 0 { 0 } else { um };
+    let mm = um.saturating_add(500) / 1000;
+    if mm > u32::MAX as i64 {
+        u32::MAX
+    } else {
+        mm as u32
+    }
 }
 
 /// Lu's whole chain on one of the peak-valley detector's steps

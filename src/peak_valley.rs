@@ -191,9 +191,6 @@ impl<const N: usize> History<N> {
     }
 
     fn push(&mut self, segment: u8, v: i32) {
-        if N == 0 {
-            return;
-        }
         if self.len == N {
             self.values.copy_within(1.., 0);
             self.values[N - 1] = (segment, v);

@@ -54,8 +54,11 @@ pub enum Detector {
     /// Stance to stance (Huang's zero-velocity detector), with gait events, phases, the
     /// ZUPT displacement and every length model: the default.
     Stance,
-    /// Lu's peak-valley detection on vertical acceleration; a stride record is one of its
-    /// steps (see [`Stride`]'s fields), measured by Lu's chain whatever the configured model.
+    /// Lu's peak-valley detection on vertical acceleration, measured by Lu's chain whatever
+    /// the configured model. A stride record is one of its steps: `start`, `heel_off` and
+    /// `toe_off` are its peak, `heel_strike` and `end` its valley; no stance, phases, ZUPT
+    /// displacement or climb are measured (flag `PHASES_GUESSED`, and `FROM_REST` on a
+    /// walk's first step).
     PeakValley,
 }
 
@@ -114,6 +117,15 @@ impl Config {
             params: &crate::trained::PARAMS,
         }
     }
+
+    /// The model behind the strides' lengths: [`Config::model`] for the stance detector,
+    /// Lu's fuzzy Weinberg (his whole chain) for the peak-valley detector.
+    pub const fn length_model(&self) -> Model {
+        match self.detector {
+            Detector::Stance => self.model,
+            Detector::PeakValley => Model::LuFuzzy,
+        }
+    }
 }
 
 const fn log2_nearest(n: u32) -> u32 {
@@ -149,8 +161,6 @@ pub struct Pipeline<const M: usize = MAX_MOVEMENT_SAMPLES> {
     rest: RestDetector,
     frame: FootFrameEstimator,
     segmenter: Segmenter<M>,
-    /// The stance detector's delay (0 with the peak-valley detector).
-    stance_delay: u32,
     rate: SampleRate,
     model: Model,
     settings: Settings,
@@ -193,10 +203,6 @@ impl<const M: usize> Pipeline<M> {
             filter,
             rest,
             frame: FootFrameEstimator::new(config.rate, config.accel),
-            stance_delay: match config.detector {
-                Detector::Stance => stance.delay(),
-                Detector::PeakValley => 0,
-            },
             segmenter: match config.detector {
                 Detector::Stance => Segmenter::Stance {
                     stance,
@@ -280,7 +286,7 @@ impl<const M: usize> Pipeline<M> {
             return None;
         }
         let at = index.wrapping_sub(self.delay);
-        let foot_at = index.wrapping_sub(self.stance_delay);
+        let foot_at = index.wrapping_sub(stance.delay());
         let (raw, foot) = (self.raw_line[slot(at)], self.foot_line[slot(foot_at)]);
         let stride = tracker.process(at, &raw, foot, decision);
         stride.map(|s| self.measure(s))
@@ -367,7 +373,7 @@ impl<const M: usize> Pipeline<M> {
     /// returns the stride they let it report, if any, not yet measured.
     fn drain(&mut self) -> Option<Stride> {
         let mut closed = None;
-        let Segmenter::Stance { tracker, .. } = &mut self.segmenter else {
+        let Segmenter::Stance { stance, tracker } = &mut self.segmenter else {
             return None;
         };
         // The tracker has had samples up to `next − 1 − delay`; the foot-frame values reach
@@ -376,7 +382,7 @@ impl<const M: usize> Pipeline<M> {
         let pending = if self.stance_fed == 0 {
             0
         } else {
-            self.stance_delay
+            stance.delay()
         };
         let slot = |i: u32| i as usize & (DELAY_CAPACITY - 1);
         for k in (0..pending).rev() {
@@ -399,22 +405,21 @@ impl<const M: usize> Pipeline<M> {
         if step.period == 0 {
             flags |= StrideFlags::FROM_REST;
         }
-        let um = models::lu_chain_um(&step, self.rate);
-        let mm = ((um.max(0) + 500) / 1000).min(u32::MAX as i64) as u32;
-        if mm > MAX_STRIDE_MM {
-            flags |= StrideFlags::IMPLAUSIBLE;
-        }
-        Stride {
+        let mut s = Stride {
             index: step.index,
             start: step.peak.index,
             heel_off: step.peak.index,
             toe_off: step.peak.index,
             heel_strike: step.valley.index,
             end: step.valley.index,
-            length_mm: mm.min(MAX_STRIDE_MM),
             flags: StrideFlags(flags),
             ..Stride::default()
-        }
+        };
+        set_length(
+            &mut s,
+            models::um_to_mm(models::lu_chain_um(&step, self.rate)),
+        );
+        s
     }
 
     /// Fills in the stride's length from the configured model; a malformed trained model
@@ -431,10 +436,16 @@ impl<const M: usize> Pipeline<M> {
         let mm = models::predict_mm(self.model, &f, self.settings, self.params)
             .or_else(|| models::predict_mm(Model::Zupt, &f, self.settings, self.params))
             .unwrap_or(0);
-        if mm > MAX_STRIDE_MM {
-            s.flags.0 |= StrideFlags::IMPLAUSIBLE;
-        }
-        s.length_mm = mm.min(MAX_STRIDE_MM);
+        set_length(&mut s, mm);
         s
     }
+}
+
+/// Sets a stride's length, clamped to [`MAX_STRIDE_MM`] and flagged
+/// [`StrideFlags::IMPLAUSIBLE`] above it.
+fn set_length(s: &mut Stride, mm: u32) {
+    if mm > MAX_STRIDE_MM {
+        s.flags.0 |= StrideFlags::IMPLAUSIBLE;
+    }
+    s.length_mm = mm.min(MAX_STRIDE_MM);
 }

@@ -7,8 +7,7 @@
 
 use core::fmt::Write;
 
-use gaitclip::models::Model;
-use gaitclip::pipeline::{Config, Detector};
+use gaitclip::pipeline::Config;
 use gaitclip::rate::SampleRate;
 use gaitclip::stride::Stride;
 
@@ -43,12 +42,9 @@ impl StrideLog {
     }
 
     /// The banner of the serial protocol (defmt logs its own): the detector, and the model
-    /// behind the lengths (Lu's chain with the peak-valley detector, whatever `config.model`).
+    /// behind the lengths ([`Config::length_model`]).
     pub fn banner(&self, board: &str, config: &Config, serial: &mut impl Write) {
-        let model = match config.detector {
-            Detector::Stance => config.model,
-            Detector::PeakValley => Model::LuFuzzy,
-        };
+        let model = config.length_model();
         defmt::info!(
             "gaitclip {=str} on {=str}: {=u32} mHz, detector {=str}, model {=str}",
             env!("CARGO_PKG_VERSION"),

@@ -7,7 +7,7 @@
 //! The core streams the same rules ([`gaitclip::peak_valley`]); a test checks both find the
 //! same steps.
 
-use gaitclip::low_pass::{alpha_q16, LOW_PASS_LSB_PER_G};
+use gaitclip::low_pass::{alpha_q16, LowPass, LOW_PASS_LSB_PER_G};
 use gaitclip::peak_valley::{
     C_DEN, C_NUM, DYNAMIC_LOOKAHEAD_MS, DYNAMIC_WINDOW, MIN_INTERVAL_MS, NEIGHBOUR_PEAK_G,
     NEIGHBOUR_VALLEY_G, STATIC_G, STATIC_WINDOW, TH1_G, TH2_G, WALK_GAP_MS,
@@ -52,12 +52,6 @@ pub fn low_pass(rate: SampleRate, x: &[f64]) -> Vec<f64> {
             y2
         })
         .collect()
-}
-
-/// The filter's delay, samples: `2·(1 − α)/α`, rounded.
-pub fn delay(rate: SampleRate) -> u32 {
-    let a = alpha_q16(rate) as f64 / 65_536.0;
-    (2.0 * (1.0 - a) / a).round() as u32
 }
 
 /// Peaks (maxima above zero) and valleys (minima below zero) of `y`; a plateau's extreme is
@@ -180,7 +174,9 @@ fn rules(list: &[Extreme], rate: SampleRate, peak: bool) -> Vec<Extreme> {
 /// without gaps.
 pub fn steps(rate: SampleRate, vertical: &[f64]) -> Vec<Step> {
     let y = low_pass(rate, vertical);
-    let all = extremes(&y, delay(rate));
+    // The delay is a definition shared with the core, like α.
+    let d = LowPass::new(rate).delay();
+    let all = extremes(&y, d);
     let peaks: Vec<Extreme> = all.iter().copied().filter(|e| e.peak).collect();
     let valleys: Vec<Extreme> = all.iter().copied().filter(|e| !e.peak).collect();
     let mut seq = rules(&peaks, rate, true);
@@ -189,7 +185,6 @@ pub fn steps(rate: SampleRate, vertical: &[f64]) -> Vec<Step> {
     // The sequence: walks split where extremes are a walk gap apart; in a walk, runs of one
     // kind keep their extreme farthest from zero; a peak pairs with the valley after it.
     let walk_gap = rate.samples_in_ms(WALK_GAP_MS);
-    let d = delay(rate);
     let mut out = Vec::new();
     let mut w = 0;
     while w < seq.len() {

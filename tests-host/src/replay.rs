@@ -25,15 +25,6 @@ pub enum ReplayError {
     Time(#[from] crate::gaps::TimeError),
 }
 
-/// The name of the length behind a record: the configured model, or Lu's chain for the
-/// peak-valley detector (which measures its steps with nothing else).
-pub const fn length_name(detector: Detector, model: Model) -> &'static str {
-    match detector {
-        Detector::Stance => model.name(),
-        Detector::PeakValley => Model::LuFuzzy.name(),
-    }
-}
-
 /// A stride as the host reports it.
 #[derive(Clone, Debug, PartialEq, Serialize)]
 pub struct StrideReport {
@@ -224,7 +215,7 @@ fn report(s: Stride, config: Config, t_s: &impl Fn(u32) -> f64) -> StrideReport 
         start_s: t_s(s.start),
         end_s: t_s(s.end),
         length_m: s.length_mm as f64 / 1000.0,
-        model: length_name(config.detector, config.model),
+        model: config.length_model().name(),
         detector: config.detector.name(),
         lengths_m: None,
         zupt_m: s.zupt_um as f64 / 1e6,
