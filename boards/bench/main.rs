@@ -8,6 +8,10 @@
 //! * [`bench_features`] and [`bench_model`]: the features of each stride and every model this
 //!   build carries, one call each, in [`Model::ALL`] order (printed at the end).
 //!
+//! With the `peak-valley-detector` feature the pipeline runs Lu's detector instead: the
+//! sample path then covers its low-pass and rules, and each step's length (Lu's chain) is
+//! counted in `Pipeline::measure_step`; there are no features or models to call.
+//!
 //! No interrupts run: the counts are the pipeline's own. The board is the QEMU machine of the
 //! target (mps2-an386 for thumbv7em, microbit for thumbv6m), with the movement buffer of the
 //! firmware that board ships.
@@ -26,7 +30,7 @@ use cortex_m_semihosting::debug;
 use defmt_semihosting as _;
 use gaitclip::features::Features;
 use gaitclip::models::{self, Model, Settings};
-use gaitclip::pipeline::{Config, Pipeline};
+use gaitclip::pipeline::{Config, Detector, Pipeline};
 use gaitclip::rate::SampleRate;
 use gaitclip::sample::{AccelRange, GyroRange, RawSample, SAMPLE_BYTES};
 use gaitclip::stride::Stride;
@@ -46,11 +50,17 @@ const fn unwrap<T: Copy>(v: Option<T>) -> T {
 }
 
 const RATE: SampleRate = unwrap(SampleRate::from_millihertz(trace::RATE_MILLIHERTZ));
-const CONFIG: Config = Config::new(
-    RATE,
-    unwrap(AccelRange::from_afs_sel(trace::ACCEL_AFS_SEL)),
-    unwrap(GyroRange::from_fs_sel(trace::GYRO_FS_SEL)),
-);
+const CONFIG: Config = {
+    let mut c = Config::new(
+        RATE,
+        unwrap(AccelRange::from_afs_sel(trace::ACCEL_AFS_SEL)),
+        unwrap(GyroRange::from_fs_sel(trace::GYRO_FS_SEL)),
+    );
+    if cfg!(feature = "peak-valley-detector") {
+        c.detector = Detector::PeakValley;
+    }
+    c
+};
 
 static PIPELINE: ConstStaticCell<Pipeline<MOVEMENT_SAMPLES>> =
     ConstStaticCell::new(Pipeline::sized(CONFIG));
@@ -62,6 +72,10 @@ fn main() -> ! {
     let mut on_stride = |s: &Stride| {
         strides += 1;
         distance_mm += u64::from(s.length_mm);
+        if CONFIG.detector == Detector::PeakValley {
+            // Lu's chain measured the step inside the pipeline; no features, no models.
+            return;
+        }
         let f = bench_features(s);
         for model in Model::ALL {
             if CONFIG.params.ships(model) {
@@ -80,6 +94,9 @@ fn main() -> ! {
     for s in pipeline.finish().iter().flatten() {
         on_stride(s);
     }
+    while let Some(s) = pipeline.take() {
+        on_stride(&s);
+    }
     defmt::println!(
         "bench samples={=u32} strides={=u32} distance_mm={=u64}",
         samples,
@@ -87,10 +104,12 @@ fn main() -> ! {
         distance_mm
     );
     // The order of the `bench_model` calls of each stride.
-    for model in Model::ALL.iter().filter(|m| CONFIG.params.ships(**m)) {
-        defmt::println!("bench model={=str}", model.name());
+    if CONFIG.detector == Detector::Stance {
+        for model in Model::ALL.iter().filter(|m| CONFIG.params.ships(**m)) {
+            defmt::println!("bench model={=str}", model.name());
+        }
     }
-    defmt::println!("bench default={=str}", CONFIG.model.name());
+    defmt::println!("bench default={=str}", CONFIG.length_model().name());
     debug::exit(debug::EXIT_SUCCESS);
     loop {
         cortex_m::asm::wfi();
