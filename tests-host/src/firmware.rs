@@ -49,6 +49,30 @@ pub fn build_with(
     Ok(target_dir.join(target).join("release").join(bin))
 }
 
+/// The cargo feature, on every board and the benchmark, that builds the firmware with Lu's
+/// peak-valley detector instead of the stance detector.
+pub const PEAK_VALLEY_FEATURE: &str = "peak-valley-detector";
+
+/// [`build_with`] for `detector`: with [`Detector::PeakValley`], the firmware built with
+/// [`PEAK_VALLEY_FEATURE`] into `target/peak-valley`, so that the default build's ELF stays.
+pub fn build_for(
+    dir: &str,
+    bin: &str,
+    target: &str,
+    detector: gaitclip::pipeline::Detector,
+    env: &[(&str, &std::ffi::OsStr)],
+) -> anyhow::Result<PathBuf> {
+    use gaitclip::pipeline::Detector;
+    match detector {
+        Detector::Stance => build_with(dir, bin, target, &[], env),
+        Detector::PeakValley => {
+            let mut env = env.to_vec();
+            env.push(("CARGO_TARGET_DIR", "target/peak-valley".as_ref()));
+            build_with(dir, bin, target, &["--features", PEAK_VALLEY_FEATURE], &env)
+        }
+    }
+}
+
 /// Builds `bin` of the top-level crate for `target`; see [`build_in`].
 pub fn build(bin: &str, target: &str) -> anyhow::Result<PathBuf> {
     build_in(".", bin, target)

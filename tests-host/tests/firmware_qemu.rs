@@ -54,17 +54,7 @@ fn strides_equal_host_replay(
     if !qemu::available_or_skip() {
         return;
     }
-    let elf = match detector {
-        Detector::Stance => firmware::build_in(dir, bin, target),
-        Detector::PeakValley => firmware::build_with(
-            dir,
-            bin,
-            target,
-            &["--features", "peak-valley-detector"],
-            &[("CARGO_TARGET_DIR", "target/peak-valley".as_ref())],
-        ),
-    }
-    .expect("firmware builds");
+    let elf = firmware::build_for(dir, bin, target, detector, &[]).expect("firmware builds");
     let out = qemu::run(
         &elf,
         &RunOptions {
