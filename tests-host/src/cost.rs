@@ -15,6 +15,9 @@ use std::path::Path;
 use anyhow::{bail, ensure, Context, Result};
 use object::{Object, ObjectSection, ObjectSymbol, SectionFlags, SymbolKind};
 
+use gaitclip::pipeline::Detector;
+
+use crate::firmware::build_for;
 use crate::qemu::{self, RunOptions};
 
 /// The functions whose calls are counted: (key, demangled name without hash). The
@@ -28,6 +31,13 @@ pub const MEASURED: [(&str, &str); 7] = [
     ("measure", "gaitclip::pipeline::Pipeline<_>::measure"),
     ("split", "gaitclip::phases::split"),
     ("stats", "gaitclip::phase_stats::StrideStats::measure"),
+];
+
+/// The functions counted in the benchmark built with `peak-valley-detector` (Lu's
+/// detector): the sample path, and Lu's chain on each step, out of line in every build.
+pub const MEASURED_PEAK_VALLEY: [(&str, &str); 2] = [
+    ("sample", "bench::bench_sample"),
+    ("step", "gaitclip::pipeline::Pipeline<_>::measure_step"),
 ];
 
 /// Instructions of each call of one function, in the order the calls returned.
@@ -85,11 +95,15 @@ pub fn parse_counts(text: &str) -> Result<HashMap<String, Calls>> {
     Ok(out)
 }
 
-/// Entry addresses of the [`MEASURED`] functions in `elf`.
-pub fn entry_addresses(elf: &[u8]) -> Result<Vec<(&'static str, u64)>> {
+/// Entry addresses of the `measured` functions ((key, demangled name), as [`MEASURED`]) in
+/// `elf`.
+pub fn entry_addresses(
+    elf: &[u8],
+    measured: &[(&'static str, &str)],
+) -> Result<Vec<(&'static str, u64)>> {
     let file = object::File::parse(elf).context("parsing the ELF")?;
     let mut found = Vec::new();
-    for (key, name) in MEASURED {
+    for &(key, name) in measured {
         let addrs: Vec<u64> = file
             .symbols()
             .filter(|s| s.kind() == SymbolKind::Text)
@@ -141,10 +155,45 @@ pub struct InsnReport {
     pub models: Vec<(String, Stat)>,
 }
 
-/// Runs the benchmark firmware `elf` on `machine` under the counting plugin `plugin`.
-pub fn run_bench(elf: &Path, machine: &str, plugin: &Path, scratch: &Path) -> Result<InsnReport> {
+/// Instruction counts of one run of the benchmark built with `peak-valley-detector`.
+#[derive(Clone, Debug)]
+pub struct StepInsnReport {
+    /// QEMU machine.
+    pub machine: String,
+    /// Samples replayed.
+    pub samples: u32,
+    /// Steps found (each a stride record).
+    pub steps: u32,
+    /// Their summed length, mm.
+    pub distance_mm: u64,
+    /// The sample path: `Pipeline::process` with the low-pass and Lu's rules, without
+    /// `Pipeline::measure_step`.
+    pub sample: Stat,
+    /// Everything per sample, the steps' chain spread over the samples (mean only).
+    pub sample_all_mean: f64,
+    /// `Pipeline::measure_step`: Lu's chain (D, f, fuzzy K, Weinberg) on one step.
+    pub step: Stat,
+}
+
+/// What one counted run printed and counted.
+struct CountedRun {
+    calls: HashMap<String, Calls>,
+    lines: Vec<String>,
+    /// samples, strides, distance_mm of the `bench samples=…` line.
+    summary: (u32, u32, u64),
+}
+
+/// Runs the benchmark firmware `elf` on `machine` under the counting plugin, counting the
+/// `measured` functions.
+fn counted_run(
+    elf: &Path,
+    machine: &str,
+    plugin: &Path,
+    scratch: &Path,
+    measured: &[(&'static str, &str)],
+) -> Result<CountedRun> {
     let bytes = std::fs::read(elf).with_context(|| format!("reading {}", elf.display()))?;
-    let entries = entry_addresses(&bytes)?;
+    let entries = entry_addresses(&bytes, measured)?;
     let out = scratch.join(format!("insn-count-{machine}.txt"));
     let mut arg = plugin.display().to_string();
     for (key, addr) in &entries {
@@ -169,9 +218,7 @@ pub fn run_bench(elf: &Path, machine: &str, plugin: &Path, scratch: &Path) -> Re
     let text = std::fs::read_to_string(&out)
         .with_context(|| format!("reading the plugin's output {}", out.display()))?;
     let calls = parse_counts(&text)?;
-    let get = |k: &str| calls.get(k).cloned().unwrap_or_default();
-    let (mut samples, mut strides, mut distance_mm) = (0, 0, 0);
-    let (mut models, mut default_model) = (Vec::new(), String::new());
+    let mut summary = None;
     for line in &run.lines {
         if let Some(rest) = line.strip_prefix("bench samples=") {
             let v: Vec<u64> = rest
@@ -179,8 +226,25 @@ pub fn run_bench(elf: &Path, machine: &str, plugin: &Path, scratch: &Path) -> Re
                 .filter_map(|t| t.parse().ok())
                 .collect();
             ensure!(v.len() == 3, "bench summary `{line}`");
-            (samples, strides, distance_mm) = (v[0] as u32, v[1] as u32, v[2]);
-        } else if let Some(m) = line.strip_prefix("bench model=") {
+            summary = Some((v[0] as u32, v[1] as u32, v[2]));
+        }
+    }
+    Ok(CountedRun {
+        calls,
+        summary: summary.with_context(|| format!("{machine}: no `bench samples=` line"))?,
+        lines: run.lines,
+    })
+}
+
+/// Runs the benchmark firmware `elf` (stance detector) on `machine` under the counting
+/// plugin `plugin`.
+pub fn run_bench(elf: &Path, machine: &str, plugin: &Path, scratch: &Path) -> Result<InsnReport> {
+    let run = counted_run(elf, machine, plugin, scratch, &MEASURED)?;
+    let get = |k: &str| run.calls.get(k).cloned().unwrap_or_default();
+    let (samples, strides, distance_mm) = run.summary;
+    let (mut models, mut default_model) = (Vec::new(), String::new());
+    for line in &run.lines {
+        if let Some(m) = line.strip_prefix("bench model=") {
             models.push(m.to_string());
         } else if let Some(m) = line.strip_prefix("bench default=") {
             default_model = m.to_string();
@@ -241,6 +305,47 @@ pub fn run_bench(elf: &Path, machine: &str, plugin: &Path, scratch: &Path) -> Re
         features: Stat::of(&get("features").inclusive),
         default_model,
         models,
+    })
+}
+
+/// Runs the benchmark firmware `elf` built with `peak-valley-detector` on `machine` under the
+/// counting plugin `plugin`.
+pub fn run_bench_peak_valley(
+    elf: &Path,
+    machine: &str,
+    plugin: &Path,
+    scratch: &Path,
+) -> Result<StepInsnReport> {
+    let run = counted_run(elf, machine, plugin, scratch, &MEASURED_PEAK_VALLEY)?;
+    let get = |k: &str| run.calls.get(k).cloned().unwrap_or_default();
+    let (samples, steps, distance_mm) = run.summary;
+    let (sample, step) = (get("sample"), get("step"));
+    ensure!(
+        run.lines.iter().any(|l| l == "bench default=lu_fuzzy"),
+        "{machine}: the benchmark did not run Lu's chain (built without peak-valley-detector?)"
+    );
+    ensure!(
+        sample.own.len() == samples as usize,
+        "{machine}: {} sample calls counted for {samples} samples",
+        sample.own.len()
+    );
+    ensure!(
+        step.inclusive.len() == steps as usize,
+        "{machine}: measure_step counted {} times for {steps} steps",
+        step.inclusive.len()
+    );
+    Ok(StepInsnReport {
+        machine: machine.into(),
+        samples,
+        steps,
+        distance_mm,
+        sample: Stat::of(&sample.own),
+        // The steps held to the end come out of `take` after the last sample, outside
+        // `bench_sample`: every step's chain is added to the samples' own work.
+        sample_all_mean: (sample.own.iter().sum::<u64>() + step.inclusive.iter().sum::<u64>())
+            as f64
+            / samples.max(1) as f64,
+        step: Stat::of(&step.inclusive),
     })
 }
 
@@ -340,37 +445,73 @@ pub struct Inputs {
 /// that of real walking (26 strides per gaitmap's pipeline, 38.7 s).
 pub const TRACE: (&str, &str, f64) = ("gaitmap_walk", "left", 204.8);
 
-/// The firmware builds whose size is reported: (name, package folder, bin, target, QEMU
-/// machine it runs on, if any).
-pub const BUILDS: [(&str, &str, &str, &str, Option<&str>); 4] = [
-    (
-        "mps2-an386 (QEMU, M4F)",
-        ".",
-        "mps2-an386",
-        "thumbv7em-none-eabihf",
-        Some(qemu::MACHINE_M4),
-    ),
-    (
-        "microbit (QEMU, M0)",
-        "boards/microbit",
-        "microbit",
-        "thumbv6m-none-eabi",
-        Some(qemu::MACHINE_M0),
-    ),
-    (
-        "nrf52840-dk (M4F)",
-        "boards/nrf52840-dk",
-        "nrf52840-dk",
-        "thumbv7em-none-eabihf",
-        None,
-    ),
-    (
-        "rp-pico (M0+)",
-        "boards/rp-pico",
-        "rp-pico",
-        "thumbv6m-none-eabi",
-        None,
-    ),
+/// A firmware build whose size is reported.
+#[derive(Clone, Copy, Debug)]
+pub struct Build {
+    /// Name in the table.
+    pub label: &'static str,
+    /// Package folder, from the repository root.
+    pub dir: &'static str,
+    /// Binary.
+    pub bin: &'static str,
+    /// Target triple.
+    pub target: &'static str,
+    /// The QEMU machine it runs on, if any (its stack is measured there).
+    pub machine: Option<&'static str>,
+    /// The step detector it is built with (see [`build_for`]).
+    pub detector: Detector,
+}
+
+/// The firmware builds whose size is reported.
+pub const BUILDS: [Build; 6] = [
+    Build {
+        label: "mps2-an386 (QEMU, M4F)",
+        dir: ".",
+        bin: "mps2-an386",
+        target: "thumbv7em-none-eabihf",
+        machine: Some(qemu::MACHINE_M4),
+        detector: Detector::Stance,
+    },
+    Build {
+        label: "mps2-an386 (QEMU, M4F), peak-valley detector",
+        dir: ".",
+        bin: "mps2-an386",
+        target: "thumbv7em-none-eabihf",
+        machine: Some(qemu::MACHINE_M4),
+        detector: Detector::PeakValley,
+    },
+    Build {
+        label: "microbit (QEMU, M0)",
+        dir: "boards/microbit",
+        bin: "microbit",
+        target: "thumbv6m-none-eabi",
+        machine: Some(qemu::MACHINE_M0),
+        detector: Detector::Stance,
+    },
+    Build {
+        label: "microbit (QEMU, M0), peak-valley detector",
+        dir: "boards/microbit",
+        bin: "microbit",
+        target: "thumbv6m-none-eabi",
+        machine: Some(qemu::MACHINE_M0),
+        detector: Detector::PeakValley,
+    },
+    Build {
+        label: "nrf52840-dk (M4F)",
+        dir: "boards/nrf52840-dk",
+        bin: "nrf52840-dk",
+        target: "thumbv7em-none-eabihf",
+        machine: None,
+        detector: Detector::Stance,
+    },
+    Build {
+        label: "rp-pico (M0+)",
+        dir: "boards/rp-pico",
+        bin: "rp-pico",
+        target: "thumbv6m-none-eabi",
+        machine: None,
+        detector: Detector::Stance,
+    },
 ];
 
 /// Measures everything and returns the Markdown report.
@@ -430,9 +571,35 @@ pub fn report(inp: &Inputs) -> Result<String> {
         insns.push(r);
     }
 
+    // Lu's detector: no movement buffer, so both machines must find the host's steps.
+    let mut lu_config = config;
+    lu_config.detector = Detector::PeakValley;
+    let lu_host = crate::replay::core_strides(&counts, lu_config);
+    let lu_host_mm: u64 = lu_host.iter().map(|s| u64::from(s.length_mm)).sum();
+    let mut lu_insns = Vec::new();
+    for (target, machine) in [
+        ("thumbv7em-none-eabihf", qemu::MACHINE_M4),
+        ("thumbv6m-none-eabi", qemu::MACHINE_M0),
+    ] {
+        let elf = build_for("boards/bench", "bench", target, Detector::PeakValley, &env)?;
+        let r = run_bench_peak_valley(&elf, machine, &inp.plugin, &inp.scratch)?;
+        ensure!(
+            (r.samples as usize, r.steps as usize, r.distance_mm)
+                == (counts.len(), lu_host.len(), lu_host_mm),
+            "{machine}, peak-valley: {} samples, {} steps / {} mm; the host replay {} / {} / {lu_host_mm}",
+            r.samples,
+            r.steps,
+            r.distance_mm,
+            counts.len(),
+            lu_host.len()
+        );
+        lu_insns.push(r);
+    }
+
     let mut sizes = Vec::new();
-    for (label, dir, bin, target, machine) in BUILDS {
-        let elf = crate::firmware::build_in(dir, bin, target)?;
+    for b in BUILDS {
+        let (label, machine) = (b.label, b.machine);
+        let elf = build_for(b.dir, b.bin, b.target, b.detector, &[])?;
         let size = size_of_elf(&std::fs::read(&elf)?)?;
         let stack = match machine {
             Some(m) => {
@@ -475,6 +642,7 @@ pub fn report(inp: &Inputs) -> Result<String> {
             host.len()
         ),
         insns,
+        lu_insns,
         sizes,
         host_rate,
         gaitmap: gm,
@@ -488,6 +656,7 @@ type BuildSize<'a> = (&'a str, Size, Option<(u32, u32)>);
 struct Report<'a> {
     trace: String,
     insns: Vec<InsnReport>,
+    lu_insns: Vec<StepInsnReport>,
     sizes: Vec<BuildSize<'a>>,
     host_rate: f64,
     gaitmap: serde_json::Value,
@@ -575,6 +744,34 @@ fn render(r: &Report) -> String {
             m0s.unwrap_or_else(|| "not in the M0 build | ".into())
         );
     }
+    let (l4, l0) = (&r.lu_insns[0], &r.lu_insns[1]);
+    let _ = writeln!(
+        o,
+        "\nWith Lu's peak-valley detector (the benchmark built with `peak-valley-detector`), on \
+         the same trace ({} steps, as the host replay finds them):\n",
+        l4.steps
+    );
+    let _ = writeln!(
+        o,
+        "| step | M4 mean | M4 max | M0 mean | M0 max |\n|---|---:|---:|---:|---:|"
+    );
+    let _ = writeln!(
+        o,
+        "| per sample: sample path (low-pass, peak-valley rules) | {} | {} |",
+        f(&l4.sample),
+        f(&l0.sample)
+    );
+    let _ = writeln!(
+        o,
+        "| per sample: all work, steps spread over the samples | {:.0} | | {:.0} | |",
+        l4.sample_all_mean, l0.sample_all_mean
+    );
+    let _ = writeln!(
+        o,
+        "| per step: Lu's chain (`Pipeline::measure_step`) | {} | {} |",
+        f(&l4.step),
+        f(&l0.step)
+    );
     let _ = writeln!(o, "\n### Size\n");
     let _ = writeln!(
         o,

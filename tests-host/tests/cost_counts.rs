@@ -1,7 +1,9 @@
 //! The instruction counts of `gaitclip cost` are sound and repeatable: the benchmark firmware
 //! (demo walk from flash) under the `qemu-insn-count` plugin finds the host replay's strides,
-//! every measured call returns, and a second run counts exactly the same.
+//! every measured call returns, and a second run counts exactly the same; with the stance
+//! detector and with Lu's peak-valley detector.
 
+use gaitclip::pipeline::{Config, Detector};
 use gaitclip_host::cost::{self, size_of_elf};
 use gaitclip_host::firmware::{self, repo_root};
 use gaitclip_host::qemu;
@@ -46,12 +48,7 @@ fn bench_counts_are_complete_and_repeatable_on_m4() {
     let b = cost::run_bench(&elf, qemu::MACHINE_M4, &plugin, &scratch).expect("counted run");
 
     let counts = gaitclip_host::fixtures::firmware_trace_counts().expect("demo trace");
-    let config = gaitclip::pipeline::Config::new(
-        gaitclip::rate::SampleRate::from_millihertz(200_000).expect("200 Hz"),
-        gaitclip::sample::AccelRange::G16,
-        gaitclip::sample::GyroRange::Dps2000,
-    );
-    let host = core_strides(&counts, config);
+    let host = core_strides(&counts, demo_config());
     assert_eq!(a.samples as usize, counts.len());
     assert_eq!(a.strides as usize, host.len());
     assert_eq!(
@@ -69,6 +66,55 @@ fn bench_counts_are_complete_and_repeatable_on_m4() {
     assert!(a.split.mean + a.stats.mean < a.close.mean);
     assert!(a.sample.mean > 0.0 && a.sample.max as f64 >= a.sample.mean);
     assert!(size_of_elf(&std::fs::read(&elf).unwrap()).unwrap().flash > 0);
+}
+
+#[test]
+fn peak_valley_bench_counts_are_complete_and_repeatable_on_m4() {
+    if !qemu::available_or_skip() {
+        return;
+    }
+    let elf = firmware::build_for(
+        "boards/bench",
+        "bench",
+        "thumbv7em-none-eabihf",
+        Detector::PeakValley,
+        &[],
+    )
+    .expect("the benchmark firmware builds with the peak-valley detector");
+    let plugin = plugin();
+    let scratch = tempdir();
+    let a = cost::run_bench_peak_valley(&elf, qemu::MACHINE_M4, &plugin, &scratch)
+        .expect("counted run");
+    let b = cost::run_bench_peak_valley(&elf, qemu::MACHINE_M4, &plugin, &scratch)
+        .expect("counted run");
+
+    let counts = gaitclip_host::fixtures::firmware_trace_counts().expect("demo trace");
+    let mut config = demo_config();
+    config.detector = Detector::PeakValley;
+    let host = core_strides(&counts, config);
+    assert!(
+        !host.is_empty(),
+        "Lu's detector finds steps in the demo walk"
+    );
+    assert_eq!(a.samples as usize, counts.len());
+    assert_eq!(a.steps as usize, host.len());
+    assert_eq!(
+        a.distance_mm,
+        host.iter().map(|s| u64::from(s.length_mm)).sum::<u64>()
+    );
+    assert_eq!((a.sample, a.step), (b.sample, b.step));
+    assert_eq!(a.step.n, host.len());
+    // The chain runs once per step, outside the sample path's own count.
+    assert!(a.sample_all_mean > a.sample.mean);
+    assert!(a.step.mean > 0.0 && a.step.max as f64 >= a.step.mean);
+}
+
+fn demo_config() -> Config {
+    Config::new(
+        gaitclip::rate::SampleRate::from_millihertz(200_000).expect("200 Hz"),
+        gaitclip::sample::AccelRange::G16,
+        gaitclip::sample::GyroRange::Dps2000,
+    )
 }
 
 fn tempdir() -> std::path::PathBuf {
