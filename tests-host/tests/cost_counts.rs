@@ -43,7 +43,7 @@ fn bench_counts_are_complete_and_repeatable_on_m4() {
     let elf = firmware::build_in("boards/bench", "bench", "thumbv7em-none-eabihf")
         .expect("the benchmark firmware builds");
     let plugin = plugin();
-    let scratch = tempdir();
+    let scratch = tempdir("m4");
     let a = cost::run_bench(&elf, qemu::MACHINE_M4, &plugin, &scratch).expect("counted run");
     let b = cost::run_bench(&elf, qemu::MACHINE_M4, &plugin, &scratch).expect("counted run");
 
@@ -82,7 +82,7 @@ fn peak_valley_bench_counts_are_complete_and_repeatable_on_m4() {
     )
     .expect("the benchmark firmware builds with the peak-valley detector");
     let plugin = plugin();
-    let scratch = tempdir();
+    let scratch = tempdir("m4-peak-valley");
     let a = cost::run_bench_peak_valley(&elf, qemu::MACHINE_M4, &plugin, &scratch)
         .expect("counted run");
     let b = cost::run_bench_peak_valley(&elf, qemu::MACHINE_M4, &plugin, &scratch)
@@ -109,6 +109,43 @@ fn peak_valley_bench_counts_are_complete_and_repeatable_on_m4() {
     assert!(a.step.mean > 0.0 && a.step.max as f64 >= a.step.mean);
 }
 
+/// The M0 build (the micro:bit's memory: ≈ 8 KiB of stack beside the pipeline) runs to the
+/// end with either detector; a stack overflow there locks QEMU up instead.
+#[test]
+fn bench_runs_to_the_end_on_m0_with_each_detector() {
+    if !qemu::available_or_skip() {
+        return;
+    }
+    let plugin = plugin();
+    let scratch = tempdir("m0");
+    let counts = gaitclip_host::fixtures::firmware_trace_counts().expect("demo trace");
+    for detector in [Detector::Stance, Detector::PeakValley] {
+        let elf = firmware::build_for("boards/bench", "bench", "thumbv6m-none-eabi", detector, &[])
+            .expect("the benchmark firmware builds for the M0");
+        match detector {
+            Detector::Stance => {
+                let r = cost::run_bench(&elf, qemu::MACHINE_M0, &plugin, &scratch)
+                    .expect("counted run on the M0");
+                assert_eq!(r.samples as usize, counts.len());
+                assert!(r.strides > 0 && r.stride.n == r.strides as usize);
+            }
+            Detector::PeakValley => {
+                let r = cost::run_bench_peak_valley(&elf, qemu::MACHINE_M0, &plugin, &scratch)
+                    .expect("counted run on the M0");
+                let mut config = demo_config();
+                config.detector = Detector::PeakValley;
+                let host = core_strides(&counts, config);
+                assert_eq!(r.samples as usize, counts.len());
+                assert_eq!(r.steps as usize, host.len());
+                assert_eq!(
+                    r.distance_mm,
+                    host.iter().map(|s| u64::from(s.length_mm)).sum::<u64>()
+                );
+            }
+        }
+    }
+}
+
 fn demo_config() -> Config {
     Config::new(
         gaitclip::rate::SampleRate::from_millihertz(200_000).expect("200 Hz"),
@@ -117,10 +154,12 @@ fn demo_config() -> Config {
     )
 }
 
-fn tempdir() -> std::path::PathBuf {
+/// A scratch folder of this test process and test: the plugin's output file is named by
+/// the machine, and the tests run in parallel.
+fn tempdir(test: &str) -> std::path::PathBuf {
     let d = repo_root()
         .join("tests-host/target/cost-test")
-        .join(std::process::id().to_string());
+        .join(format!("{}-{test}", std::process::id()));
     std::fs::create_dir_all(&d).expect("scratch folder");
     d
 }
