@@ -628,14 +628,22 @@ impl PeakValleyDetector {
             let deadline = self.run_last.wrapping_add(self.walk_gap);
             let ended = match front {
                 Some(f) if f.segment != self.run_segment => true,
+                // In time to follow the walk: it waits on the front's rules, which set their
+                // own wake-ups. (A wake-up at this deadline would soon lie in the past and
+                // run the rules on every sample until the front is decided.)
                 Some(f) if !reached(f.e.index, deadline) => false,
-                _ => self.watermark_reached(self.run_segment, deadline),
+                _ => {
+                    let ended = self.watermark_reached(self.run_segment, deadline);
+                    if !ended {
+                        self.later_wake(deadline);
+                    }
+                    ended
+                }
             };
             if ended {
                 self.end_walk();
                 return true;
             }
-            self.later_wake(deadline);
         }
         let Some(front) = front.filter(|f| f.passed == NOT_OUTLIER) else {
             return false;
