@@ -14,7 +14,10 @@
 //! How: every instruction adds one to a counter inline (exact, not per translation block).
 //! A call is a `bl` whose target is a measured entry: the plugin notes the counter and the
 //! return address (the instruction after the `bl`). A return lands on a translation block's
-//! first instruction, so only those are checked against the innermost open call. A function
+//! first instruction, so only those are checked against the innermost open call. A `bl` in an
+//! IT block (Thumb-2) runs the callback even when its condition fails: such a call counts
+//! only once the block at its entry has run, and is dropped, unrecorded, when the block after
+//! the `bl` runs first. A function
 //! reached any other way (`blx` through a pointer, a tail call) is not seen; the firmware that
 //! is measured calls its measured functions with `bl`, through wrappers where need be.
 //!
@@ -36,6 +39,9 @@ static mut COUNT: u64 = 0;
 
 struct Open {
     function: usize,
+    /// The function's entry; until its block runs, the `bl` may have been skipped.
+    entry: u64,
+    entered: bool,
     return_addr: u64,
     start: u64,
     /// Inclusive counts of measured calls made inside this one.
@@ -77,51 +83,80 @@ fn bl_target(pc: u64, h1: u16, h2: u16) -> Option<u64> {
 }
 
 /// What a callback needs to know about its instruction; leaked, like QEMU's translations.
+#[derive(Clone, Copy)]
 struct Call {
     function: usize,
+    entry: u64,
     return_addr: u64,
+}
+
+impl State {
+    /// A `bl` to a measured function ran (its condition may have failed) at count `now`.
+    fn call(&mut self, call: Call, now: u64) {
+        self.open.push(Open {
+            function: call.function,
+            entry: call.entry,
+            entered: false,
+            return_addr: call.return_addr,
+            start: now,
+            nested: 0,
+        });
+    }
+
+    /// A translation block starting at `pc` runs, at count `now`.
+    fn block_start(&mut self, pc: u64, now: u64) {
+        if let Some(top) = self.open.last_mut() {
+            if !top.entered {
+                if pc == top.entry {
+                    top.entered = true;
+                    return;
+                }
+                if pc == top.return_addr {
+                    // A conditional `bl` whose condition failed: no call.
+                    self.open.pop();
+                    return;
+                }
+            }
+        }
+        // Calls whose return was never seen (left by an exception, say) are dropped up to the
+        // one this address returns from.
+        let Some(depth) = self.open.iter().rposition(|o| o.return_addr == pc) else {
+            return;
+        };
+        while self.open.len() > depth {
+            let Some(done) = self.open.pop() else { break };
+            let inclusive = now - done.start;
+            let own = inclusive - done.nested;
+            if self.open.len() == depth {
+                let _ = writeln!(
+                    self.lines,
+                    "call {} {inclusive} {own}",
+                    self.names[done.function]
+                );
+            } else {
+                let _ = writeln!(self.lines, "lost {}", self.names[done.function]);
+            }
+            if let Some(parent) = self.open.last_mut() {
+                parent.nested += inclusive;
+            }
+        }
+    }
 }
 
 unsafe extern "C" fn on_call(_vcpu: c_uint, udata: *mut c_void) {
     // Note(unsafe): udata is a leaked `Call` made at translation, never freed.
-    let call = unsafe { &*(udata as *const Call) };
-    let start = count();
+    let call = unsafe { *(udata as *const Call) };
+    let now = count();
     if let Some(state) = STATE.lock().unwrap_or_else(|e| e.into_inner()).as_mut() {
-        state.open.push(Open {
-            function: call.function,
-            return_addr: call.return_addr,
-            start,
-            nested: 0,
-        });
+        state.call(call, now);
     }
 }
 
 unsafe extern "C" fn on_block_start(_vcpu: c_uint, udata: *mut c_void) {
     let pc = udata as u64;
     let now = count();
-    let mut guard = STATE.lock().unwrap_or_else(|e| e.into_inner());
-    let Some(state) = guard.as_mut() else { return };
-    // Calls whose return was never seen (left by an exception, say) are dropped up to the
-    // one this address returns from.
-    let Some(depth) = state.open.iter().rposition(|o| o.return_addr == pc) else {
-        return;
-    };
-    while state.open.len() > depth {
-        let Some(done) = state.open.pop() else { break };
-        let inclusive = now - done.start;
-        let own = inclusive - done.nested;
-        if state.open.len() == depth {
-            let _ = writeln!(
-                state.lines,
-                "call {} {inclusive} {own}",
-                state.names[done.function]
-            );
-        } else {
-            let _ = writeln!(state.lines, "lost {}", state.names[done.function]);
-        }
-        if let Some(parent) = state.open.last_mut() {
-            parent.nested += inclusive;
-        }
+    if let Some(state) = STATE.lock().unwrap_or_else(|e| e.into_inner()).as_mut() {
+        state.block_start(pc, now);
     }
 }
 
@@ -154,9 +189,13 @@ unsafe extern "C" fn on_translate(_id: qemu_plugin_id_t, tb: *mut qemu_plugin_tb
                     core::slice::from_raw_parts(qemu_plugin_insn_data(insn) as *const u8, 4);
                 let h1 = u16::from_le_bytes([bytes[0], bytes[1]]);
                 let h2 = u16::from_le_bytes([bytes[2], bytes[3]]);
-                if let Some(&function) = bl_target(pc, h1, h2).and_then(|t| state.entries.get(&t)) {
+                let target = bl_target(pc, h1, h2);
+                if let Some((entry, &function)) =
+                    target.and_then(|t| state.entries.get(&t).map(|f| (t, f)))
+                {
                     let call = Box::leak(Box::new(Call {
                         function,
+                        entry,
                         return_addr: pc + 4,
                     }));
                     qemu_plugin_register_vcpu_insn_exec_cb(
@@ -248,7 +287,51 @@ pub unsafe extern "C" fn qemu_plugin_install(
 
 #[cfg(test)]
 mod tests {
-    use super::bl_target;
+    use super::{bl_target, Call, State};
+
+    fn state() -> State {
+        State {
+            names: vec!["outer".into(), "inner".into()],
+            ..State::default()
+        }
+    }
+
+    const OUTER: Call = Call {
+        function: 0,
+        entry: 0x100,
+        return_addr: 0x54,
+    };
+    const INNER: Call = Call {
+        function: 1,
+        entry: 0x200,
+        return_addr: 0x130,
+    };
+
+    #[test]
+    fn a_call_counts_from_its_bl_to_its_return_and_nested_calls_leave_own() {
+        let mut s = state();
+        s.call(OUTER, 10);
+        s.block_start(0x100, 11);
+        s.call(INNER, 20);
+        s.block_start(0x200, 21);
+        s.block_start(0x130, 45);
+        s.block_start(0x54, 60);
+        assert_eq!(s.lines, "call inner 25 25\ncall outer 50 25\n");
+        assert!(s.open.is_empty());
+    }
+
+    #[test]
+    fn a_skipped_conditional_bl_is_no_call() {
+        let mut s = state();
+        s.call(OUTER, 10);
+        s.block_start(0x100, 11);
+        // `blpl inner` with the condition failed: the block after it runs next.
+        s.call(INNER, 20);
+        s.block_start(0x130, 21);
+        s.block_start(0x54, 30);
+        assert_eq!(s.lines, "call outer 20 20\n");
+        assert!(s.open.is_empty());
+    }
 
     #[test]
     fn decodes_bl_both_ways() {
