@@ -326,6 +326,19 @@ impl PeakValleyDetector {
     /// [`PeakValleyDetector::filter_delay`] taken off. For tests of the rules on hand-made
     /// signals, and for a caller with its own filter.
     pub fn process_filtered(&mut self, index: u32, y: i32) -> Option<Step> {
+        self.feed_filtered(index, y);
+        self.ready.take()
+    }
+
+    /// [`PeakValleyDetector::process`] without handing out a step: one that is ready stays
+    /// ready for the next call (the pipeline feeds several samples in one call when it
+    /// bridges a hole, and reports one step per call).
+    pub fn feed(&mut self, index: u32, vertical: i16) {
+        let y = self.filter.process(vertical);
+        self.feed_filtered(index, y);
+    }
+
+    fn feed_filtered(&mut self, index: u32, y: i32) {
         let found = self.find(index, y);
         if let Some(e) = found {
             let x = InFlight {
@@ -340,7 +353,6 @@ impl PeakValleyDetector {
         if found.is_some() || self.dirty || reached(index, self.wake_at) {
             self.decide();
         }
-        self.ready.take()
     }
 
     /// Samples were lost: the filter starts afresh, and what is in flight is decided as at
@@ -428,6 +440,11 @@ impl PeakValleyDetector {
 
     /// Runs the rules until nothing more can be decided or a step is ready.
     fn decide(&mut self) {
+        if self.ready.is_some() {
+            // The step before is still to be handed out: decide again at the next call.
+            self.dirty = true;
+            return;
+        }
         self.dirty = false;
         self.wake_at = self.candidate.index.wrapping_add(self.walk_gap);
         while self.ready.is_none() {

@@ -33,7 +33,10 @@ use crate::rate::SampleRate;
 use crate::rest::{RestDetector, RestThresholds};
 use crate::sample::{AccelRange, GyroRange, RawSample};
 use crate::stance::{StanceDetector, StanceThresholds};
-use crate::stride::{Stride, StrideFlags, StrideTracker, MAX_MOVEMENT_SAMPLES, MAX_STRIDE_MM};
+use crate::stride::{
+    Origin, Stride, StrideFlags, StrideTracker, MAX_MOVEMENT_SAMPLES, MAX_STRIDE_MM,
+    MIN_MOVEMENT_MS,
+};
 
 /// Capacity of the mean filter; the window used is the power of two nearest
 /// [`MEAN_FILTER_MS`] at the sample rate, at most this.
@@ -43,6 +46,19 @@ pub const MEAN_FILTER_MS: u32 = 20;
 /// Capacity of the delay lines that align raw samples and foot-frame samples with the
 /// (centred) stance decision: ≥ stance delay (63) + filter delay (7) + 1.
 pub const DELAY_CAPACITY: usize = 128;
+
+/// Longest hole of lost samples that is bridged: interpolated across when the next sample
+/// arrives, the stride it falls in flagged [`StrideFlags::BRIDGED`] and still measured.
+/// Chosen by measurement (`gaitclip holes`, the README's hole table): the longest hole
+/// whose mean |length error| against the uncut recordings stays ≤ 1 cm.
+pub const BRIDGE_MAX_MS: u32 = 40;
+/// Longest hole interpolated at all. A longer hole than [`BRIDGE_MAX_MS`], up to this, is
+/// filled too so that the stride's events outside it are still found, but a stride whose
+/// movement it falls in is a [`StrideFlags::GAP`] stride without a length. Anything longer
+/// restarts detection after it. At most [`MIN_MOVEMENT_MS`]: the samples one call then
+/// feeds are fewer than separate two strides, so one call never has two to report.
+pub const FILL_MAX_MS: u32 = MIN_MOVEMENT_MS;
+const _: () = assert!(BRIDGE_MAX_MS <= FILL_MAX_MS && FILL_MAX_MS <= MIN_MOVEMENT_MS);
 
 /// The model the firmware ships with as its stride length (see the README's length
 /// table for why).
@@ -99,6 +115,9 @@ pub struct Config {
     pub settings: Settings,
     /// Trained coefficients and SVRs.
     pub params: &'static ModelParams<'static>,
+    /// Longest hole bridged, ms ([`BRIDGE_MAX_MS`]; clamped to [`FILL_MAX_MS`]). A setting
+    /// so that the hole-length sweep can measure what each limit costs.
+    pub bridge_max_ms: u32,
 }
 
 impl Config {
@@ -115,6 +134,7 @@ impl Config {
             model: DEFAULT_MODEL,
             settings: Settings::DEFAULT,
             params: &crate::trained::PARAMS,
+            bridge_max_ms: BRIDGE_MAX_MS,
         }
     }
 
@@ -139,6 +159,51 @@ const fn log2_nearest(n: u32) -> u32 {
     } else {
         k
     }
+}
+
+/// Holes of lost samples the pipeline has met, by what it did with them.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct HoleCounts {
+    /// Holes bridged ([`BRIDGE_MAX_MS`] or shorter).
+    pub bridged: u32,
+    /// Samples interpolated across them.
+    pub bridged_samples: u32,
+    /// Longer holes ([`FILL_MAX_MS`] or shorter) filled for the events: gaps.
+    pub filled: u32,
+    /// Samples interpolated across them.
+    pub filled_samples: u32,
+    /// Holes after which detection restarted: gaps.
+    pub restarted: u32,
+    /// Samples lost in them.
+    pub restarted_samples: u32,
+}
+
+impl HoleCounts {
+    /// Holes that are gaps (filled or restarted): the strides their movements fall in have
+    /// no length.
+    pub const fn gaps(&self) -> u32 {
+        self.filled.saturating_add(self.restarted)
+    }
+
+    /// Samples lost in the gaps.
+    pub const fn gap_samples(&self) -> u32 {
+        self.filled_samples.saturating_add(self.restarted_samples)
+    }
+}
+
+/// A hole waiting for the sample after it, to be interpolated across.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+struct PendingHole {
+    missing: u32,
+    origin: Origin,
+}
+
+/// What one call's samples released, not yet measured.
+#[allow(clippy::large_enum_variant)] // one at a time, on the caller's frame
+enum Released {
+    Nothing,
+    Stride(Stride),
+    Step(Step),
 }
 
 /// The step detector's state. A pipeline runs one detector for its life, so the two share
@@ -167,6 +232,16 @@ pub struct Pipeline<const M: usize = MAX_MOVEMENT_SAMPLES> {
     params: &'static ModelParams<'static>,
     raw_line: [RawSample; DELAY_CAPACITY],
     foot_line: [[i16; 3]; DELAY_CAPACITY],
+    /// One bit per delay-line slot: the sample was interpolated ([`Origin::Bridged`]).
+    bridged_line: u128,
+    /// One bit per delay-line slot: the sample was interpolated ([`Origin::Filled`]).
+    filled_line: u128,
+    /// Longest hole bridged / filled, samples.
+    bridge_max: u32,
+    fill_max: u32,
+    /// A hole to interpolate across at the next sample.
+    hole: PendingHole,
+    holes: HoleCounts,
     /// Samples between an input and the raw sample the rest decision is about.
     rest_delay: u32,
     /// Samples between an input and the raw sample the stance decision is about.
@@ -220,6 +295,28 @@ impl<const M: usize> Pipeline<M> {
                 temp: 0,
             }; DELAY_CAPACITY],
             foot_line: [[0; 3]; DELAY_CAPACITY],
+            bridged_line: 0,
+            filled_line: 0,
+            bridge_max: config
+                .rate
+                .samples_in_ms(if config.bridge_max_ms < FILL_MAX_MS {
+                    config.bridge_max_ms
+                } else {
+                    FILL_MAX_MS
+                }),
+            fill_max: config.rate.samples_in_ms(FILL_MAX_MS),
+            hole: PendingHole {
+                missing: 0,
+                origin: Origin::Measured,
+            },
+            holes: HoleCounts {
+                bridged: 0,
+                bridged_samples: 0,
+                filled: 0,
+                filled_samples: 0,
+                restarted: 0,
+                restarted_samples: 0,
+            },
             rest_delay,
             delay,
             next: 0,
@@ -253,12 +350,44 @@ impl<const M: usize> Pipeline<M> {
         self.frame.gyro_bias()
     }
 
-    /// Feeds one sample; returns a stride when one can be reported.
+    /// Feeds one sample; returns a stride when one can be reported. After a hole that
+    /// [`Pipeline::gap`] keeps for bridging, the samples it lost are first interpolated
+    /// between the last sample and this one.
     pub fn process(&mut self, s: &RawSample) -> Option<Stride> {
+        let hole = core::mem::take(&mut self.hole);
+        let mut out = Released::Nothing;
+        if hole.missing > 0 {
+            let last = self.raw_line[slot(self.next.wrapping_sub(1))];
+            for k in 1..=hole.missing {
+                let x = interpolate(&last, s, k, hole.missing + 1);
+                self.step(&x, hole.origin, &mut out);
+            }
+        }
+        self.step(s, Origin::Measured, &mut out);
+        self.measure_released(out)
+    }
+
+    /// The holes met so far, by what was done with them.
+    pub const fn holes(&self) -> HoleCounts {
+        self.holes
+    }
+
+    /// One sample through the stages; what it releases goes into `out` (at most one thing
+    /// per call of [`Pipeline::process`], see [`FILL_MAX_MS`]; a second stride would be
+    /// held back by the tracker, a second step by the peak-valley detector).
+    #[inline(always)]
+    fn step(&mut self, s: &RawSample, origin: Origin, out: &mut Released) {
         let index = self.next;
         self.next = self.next.wrapping_add(1);
-        let slot = |i: u32| i as usize & (DELAY_CAPACITY - 1);
         self.raw_line[slot(index)] = *s;
+        let bit = 1u128 << slot(index);
+        self.bridged_line &= !bit;
+        self.filled_line &= !bit;
+        match origin {
+            Origin::Measured => {}
+            Origin::Bridged => self.bridged_line |= bit,
+            Origin::Filled => self.filled_line |= bit,
+        }
         self.since_reset = self.since_reset.saturating_add(1);
         let filtered = self.filter.process(s.accel);
         if let Some(rest) = self.rest.process(filtered, s.gyro) {
@@ -267,43 +396,154 @@ impl<const M: usize> Pipeline<M> {
                 self.frame.process(&self.raw_line[slot(at)], rest);
             }
         }
-        let frame = self.frame.frame()?;
+        let Some(frame) = self.frame.frame() else {
+            return;
+        };
         let foot = frame.apply(filtered);
         let (stance, tracker) = match &mut self.segmenter {
             Segmenter::Stance { stance, tracker } => (stance, tracker),
             Segmenter::PeakValley(peaks) => {
                 // The filtered value is the mean of a window centred `delay` samples back.
                 let at = index.wrapping_sub(self.filter.delay());
-                let step = peaks.process(at, foot[2]);
-                return step.map(|s| self.measure_step(s));
+                match out {
+                    Released::Nothing => {
+                        if let Some(step) = peaks.process(at, foot[2]) {
+                            *out = Released::Step(step);
+                        }
+                    }
+                    _ => peaks.feed(at, foot[2]),
+                }
+                return;
             }
         };
         self.foot_line[slot(index)] = foot;
-        let decision = stance.process(foot, s.gyro)?;
+        let Some(decision) = stance.process(foot, s.gyro) else {
+            return;
+        };
         self.stance_fed = self.stance_fed.saturating_add(1);
         self.last_decision = decision;
         if self.since_reset <= self.delay {
-            return None;
+            return;
         }
         let at = index.wrapping_sub(self.delay);
         let foot_at = index.wrapping_sub(stance.delay());
         let (raw, foot) = (self.raw_line[slot(at)], self.foot_line[slot(foot_at)]);
-        let stride = tracker.process(at, &raw, foot, decision);
-        stride.map(|s| self.measure(s))
+        let origin = origin_of(self.bridged_line, self.filled_line, at);
+        if let Some(stride) = tracker.process(at, &raw, foot, decision, origin) {
+            match out {
+                Released::Nothing => *out = Released::Stride(stride),
+                _ => tracker.hold(stride),
+            }
+        }
+    }
+
+    /// Measures what a call released.
+    fn measure_released(&self, out: Released) -> Option<Stride> {
+        match out {
+            Released::Nothing => None,
+            Released::Stride(s) => Some(self.measure(s)),
+            Released::Step(s) => Some(self.measure_step(s)),
+        }
     }
 
     /// Declares `missing` samples lost (FIFO overflow, a sensor that stopped answering, a
-    /// jump in timestamps). The samples still in the delay line are drained as at
-    /// [`Pipeline::finish`], the stride in progress becomes a
-    /// [`crate::stride::StrideFlags::GAP`] stride (no length, reported once the next stance
-    /// is found after the gap), and detection restarts after it. Returns the stride the drain
-    /// let the tracker report or that it held, complete and measured as usual.
+    /// jump in timestamps). What happens depends on how long the hole is:
     ///
-    /// With [`Detector::PeakValley`] the steps in flight are decided as at the end of a
-    /// recording and come out of the next calls to [`Pipeline::process`].
+    /// - **Up to [`BRIDGE_MAX_MS`]: bridged.** Nothing happens until the next sample; then
+    ///   the missing samples are interpolated (linearly, per axis) between the samples
+    ///   either side and fed as if measured. The stride they fall in is flagged
+    ///   [`StrideFlags::BRIDGED`] and keeps its length and events.
+    /// - **Up to [`FILL_MAX_MS`]: filled.** Interpolated the same way, so that detection
+    ///   goes on and the events outside the hole are found, but a stride whose movement the
+    ///   hole falls in is a [`StrideFlags::GAP`] stride, without a length (an event found
+    ///   inside the hole is set to its first sample). In a stance, where the foot is at rest
+    ///   either side, it only flags the stride [`StrideFlags::BRIDGED`].
+    /// - **Longer: detection restarts.** The samples still in the delay line are drained as
+    ///   at [`Pipeline::finish`], the stride in progress becomes a [`StrideFlags::GAP`]
+    ///   stride (no length; heel-off and foot-flat measured, toe-off and heel-strike set to
+    ///   the first missing sample; reported once the next stance is found after the gap),
+    ///   and detection restarts after it. Returns the stride the drain let the tracker
+    ///   report or that it held, complete and measured as usual. With
+    ///   [`Detector::PeakValley`] the steps in flight are decided as at the end of a
+    ///   recording and come out of the next calls to [`Pipeline::process`].
+    ///
+    /// Holes declared one after the other without a sample between add up. The samples
+    /// fed are numbered on past the missing ones either way, so that indices keep
+    /// counting sensor periods. [`Pipeline::holes`] counts what was done.
     // Not inlined: its strides would otherwise sit in the caller's frame on the sample path.
     #[inline(never)]
     pub fn gap(&mut self, missing: u32) -> Option<Stride> {
+        if missing == 0 {
+            return None;
+        }
+        let total = self.hole.missing.saturating_add(missing);
+        if self.next > 0 && total <= self.fill_max {
+            // Kept for the next sample to interpolate towards; counted as what it became.
+            let (was, now) = (self.hole.origin, self.origin_for(total));
+            self.uncount(self.hole);
+            self.hole = PendingHole {
+                missing: total,
+                origin: now,
+            };
+            self.count(self.hole);
+            if now == Origin::Filled && was != Origin::Filled {
+                // A movement with a long hole in it does not teach the foot frame.
+                self.frame.gap();
+            }
+            return None;
+        }
+        // Too long to interpolate (or nothing before it): a pending part joins it.
+        self.uncount(self.hole);
+        self.hole = PendingHole::default();
+        self.holes.restarted = self.holes.restarted.saturating_add(1);
+        self.holes.restarted_samples = self.holes.restarted_samples.saturating_add(total);
+        self.restart_after(total)
+    }
+
+    fn origin_for(&self, missing: u32) -> Origin {
+        if missing <= self.bridge_max {
+            Origin::Bridged
+        } else {
+            Origin::Filled
+        }
+    }
+
+    fn count(&mut self, h: PendingHole) {
+        let c = &mut self.holes;
+        match h.origin {
+            Origin::Bridged => {
+                c.bridged = c.bridged.saturating_add(1);
+                c.bridged_samples = c.bridged_samples.saturating_add(h.missing);
+            }
+            Origin::Filled => {
+                c.filled = c.filled.saturating_add(1);
+                c.filled_samples = c.filled_samples.saturating_add(h.missing);
+            }
+            Origin::Measured => {}
+        }
+    }
+
+    fn uncount(&mut self, h: PendingHole) {
+        let c = &mut self.holes;
+        if h.missing == 0 {
+            return;
+        }
+        match h.origin {
+            Origin::Bridged => {
+                c.bridged = c.bridged.saturating_sub(1);
+                c.bridged_samples = c.bridged_samples.saturating_sub(h.missing);
+            }
+            Origin::Filled => {
+                c.filled = c.filled.saturating_sub(1);
+                c.filled_samples = c.filled_samples.saturating_sub(h.missing);
+            }
+            Origin::Measured => {}
+        }
+    }
+
+    /// The hole is too long to interpolate: drain, close the stride as a gap stride and
+    /// start detection afresh after `missing` samples.
+    fn restart_after(&mut self, missing: u32) -> Option<Stride> {
         // The drain runs on one stance decision, so it makes one transition at most, and
         // then the tracker holds nothing to hand back; should both ever carry a stride, the
         // later one stays held (reported after the gap), so nothing is lost.
@@ -341,6 +581,15 @@ impl<const M: usize> Pipeline<M> {
     /// open). With [`Detector::PeakValley`] the first step still in flight; the others come
     /// from [`Pipeline::take`].
     pub fn finish(&mut self) -> [Option<Stride>; 2] {
+        if self.hole.missing > 0 {
+            // A hole at the very end has no sample after it to interpolate towards: the
+            // recording simply ended before it (counted as lost).
+            let hole = core::mem::take(&mut self.hole);
+            self.uncount(hole);
+            self.holes.restarted = self.holes.restarted.saturating_add(1);
+            self.holes.restarted_samples =
+                self.holes.restarted_samples.saturating_add(hole.missing);
+        }
         let drained = self.drain();
         let Segmenter::Stance { tracker, .. } = &mut self.segmenter else {
             return [self.take(), None];
@@ -384,12 +633,12 @@ impl<const M: usize> Pipeline<M> {
         } else {
             stance.delay()
         };
-        let slot = |i: u32| i as usize & (DELAY_CAPACITY - 1);
         for k in (0..pending).rev() {
             let at = self.next.wrapping_sub(1 + fd).wrapping_sub(k);
             let foot_at = at.wrapping_add(fd);
             let (raw, foot) = (self.raw_line[slot(at)], self.foot_line[slot(foot_at)]);
-            if let Some(st) = tracker.process(at, &raw, foot, self.last_decision) {
+            let origin = origin_of(self.bridged_line, self.filled_line, at);
+            if let Some(st) = tracker.process(at, &raw, foot, self.last_decision, origin) {
                 closed = Some(st);
             }
         }
@@ -438,6 +687,41 @@ impl<const M: usize> Pipeline<M> {
             .unwrap_or(0);
         set_length(&mut s, mm);
         s
+    }
+}
+
+/// The delay-line slot of sample number `i`.
+const fn slot(i: u32) -> usize {
+    i as usize & (DELAY_CAPACITY - 1)
+}
+
+/// Whether sample `at`, still in the delay line, was measured or interpolated: its bit in
+/// the `bridged` and `filled` masks.
+const fn origin_of(bridged: u128, filled: u128, at: u32) -> Origin {
+    let bit = 1u128 << slot(at);
+    if bridged & bit != 0 {
+        Origin::Bridged
+    } else if filled & bit != 0 {
+        Origin::Filled
+    } else {
+        Origin::Measured
+    }
+}
+
+/// Sample `k` of the `n` periods from `a` (k = 0) to `b` (k = n), each axis on the straight
+/// line between them, rounded to the nearest count (halves up). Exact to rounding for
+/// `0 ≤ k ≤ n`: `|a·(n − k) + b·k| < 2¹⁵·n` fits an `i32` for any `n` < 2¹⁵.
+fn interpolate(a: &RawSample, b: &RawSample, k: u32, n: u32) -> RawSample {
+    let (k, n) = (k as i32, n as i32);
+    let at = |x: i16, y: i16| -> i16 {
+        let v = x as i32 * (n - k) + y as i32 * k;
+        (2 * v + n).div_euclid(2 * n) as i16
+    };
+    let axes = |x: [i16; 3], y: [i16; 3]| [at(x[0], y[0]), at(x[1], y[1]), at(x[2], y[2])];
+    RawSample {
+        accel: axes(a.accel, b.accel),
+        gyro: axes(a.gyro, b.gyro),
+        temp: at(a.temp, b.temp),
     }
 }
 

@@ -61,31 +61,37 @@ pub const MAX_STRIDE_MM: u32 = 6000;
 
 /// Properties of a stride that qualify its length.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
-pub struct StrideFlags(pub u8);
+pub struct StrideFlags(pub u16);
 
 impl StrideFlags {
     /// A sample of the movement sat at a rail of its range: the length is uncertain.
-    pub const SATURATED: u8 = 1 << 0;
+    pub const SATURATED: u16 = 1 << 0;
     /// The movement overflowed the movement buffer: not a walking stride.
-    pub const TOO_LONG: u8 = 1 << 1;
+    pub const TOO_LONG: u16 = 1 << 1;
     /// The stride starts from a stance longer than [`MAX_STANCE_IN_STRIDE_MS`]: the first
     /// step after standing (informational).
-    pub const FROM_REST: u8 = 1 << 2;
+    pub const FROM_REST: u16 = 1 << 2;
     /// The stance after the stride lasted longer than [`MAX_STANCE_IN_STRIDE_MS`], or the
     /// recording ended in it: the last step before standing, often a half-stride.
-    pub const TO_REST: u8 = 1 << 3;
+    pub const TO_REST: u16 = 1 << 3;
     /// The heading changed by more than 45° over the movement: a turn.
-    pub const TURN: u8 = 1 << 4;
+    pub const TURN: u16 = 1 << 4;
     /// The phase splitter found no major peak-valley pair for a boundary: toe-off and
     /// heel-strike are cluster centres, not measured events.
-    pub const PHASES_GUESSED: u8 = 1 << 5;
-    /// Samples were lost inside the stride (a gap): it has no length, and its events after
-    /// the gap are unknown (toe-off and heel-strike are set to the first missing sample).
-    pub const GAP: u8 = 1 << 6;
+    pub const PHASES_GUESSED: u16 = 1 << 5;
+    /// Samples were lost inside the stride's movement (a gap longer than
+    /// [`crate::pipeline::BRIDGE_MAX_MS`]): it has no length. Its events outside the hole
+    /// are measured; an event that falls inside the hole is unknown and set to the hole's
+    /// first missing sample (see [`crate::pipeline::Pipeline::gap`]).
+    pub const GAP: u16 = 1 << 6;
     /// The length model gave more than [`MAX_STRIDE_MM`]; the length is clamped to it.
-    pub const IMPLAUSIBLE: u8 = 1 << 7;
+    pub const IMPLAUSIBLE: u16 = 1 << 7;
+    /// A short hole of lost samples (at most [`crate::pipeline::BRIDGE_MAX_MS`], or a
+    /// longer one inside the stance) was bridged by interpolation: the stride and its
+    /// length stay valid (informational).
+    pub const BRIDGED: u16 = 1 << 8;
     /// Flags that make a length untrustworthy.
-    pub const INVALID: u8 = Self::SATURATED | Self::TOO_LONG | Self::GAP | Self::IMPLAUSIBLE;
+    pub const INVALID: u16 = Self::SATURATED | Self::TOO_LONG | Self::GAP | Self::IMPLAUSIBLE;
 
     /// True when no flag in [`StrideFlags::INVALID`] is set.
     pub const fn valid(self) -> bool {
@@ -93,7 +99,7 @@ impl StrideFlags {
     }
 
     /// True when `flag` is set.
-    pub const fn has(self, flag: u8) -> bool {
+    pub const fn has(self, flag: u16) -> bool {
         self.0 & flag != 0
     }
 }
@@ -126,6 +132,23 @@ pub struct Stride {
     pub stats: StrideStats,
 }
 
+/// Where a sample fed to the tracker comes from: the sensor, or the pipeline's
+/// interpolation across a hole of lost samples ([`crate::pipeline::Pipeline::gap`]).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
+pub enum Origin {
+    /// Read from the sensor.
+    #[default]
+    Measured,
+    /// Interpolated across a hole short enough to measure through
+    /// ([`crate::pipeline::BRIDGE_MAX_MS`]): the stride is [`StrideFlags::BRIDGED`].
+    Bridged,
+    /// Interpolated across a longer hole ([`crate::pipeline::FILL_MAX_MS`]), so that the
+    /// stride's events outside the hole can still be found: in a movement the stride is a
+    /// [`StrideFlags::GAP`] stride, in a stance only [`StrideFlags::BRIDGED`] (a foot at rest
+    /// is at rest either side of it).
+    Filled,
+}
+
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 enum State {
     /// No stance seen yet: nothing to integrate from.
@@ -148,7 +171,11 @@ pub struct StrideTracker<const M: usize = MAX_MOVEMENT_SAMPLES> {
     heel_off: u32,
     stance_sums: RestSums,
     movement: Vec<[i16; CHANNELS], M>,
-    flags: u8,
+    flags: u16,
+    /// First and last [`Origin::Filled`] sample of the movement, if any.
+    filled: Option<(u32, u32)>,
+    /// Last interpolated sample of the current stance, if any.
+    stance_bridged_at: Option<u32>,
     next_index: u32,
     phase_method: PhaseMethod,
     merge_samples: u32,
@@ -185,6 +212,8 @@ impl<const M: usize> StrideTracker<M> {
             stance_sums: RestSums::new(),
             movement: Vec::new(),
             flags: 0,
+            filled: None,
+            stance_bridged_at: None,
             next_index: 0,
             phase_method,
             merge_samples: rate.samples_in_ms(phases::MERGE_MS),
@@ -264,9 +293,9 @@ impl<const M: usize> StrideTracker<M> {
         } else {
             self.stance_start
         };
-        let mut flags = StrideFlags::GAP;
+        let mut flags = StrideFlags::GAP | self.stance_flags(start);
         if self.gap_in_movement {
-            flags |= self.flags & StrideFlags::SATURATED;
+            flags |= self.flags & (StrideFlags::SATURATED | StrideFlags::BRIDGED);
         }
         let index = self.next_index;
         self.next_index = self.next_index.wrapping_add(1);
@@ -284,19 +313,62 @@ impl<const M: usize> StrideTracker<M> {
 
     fn clear_stance(&mut self) {
         self.stance_sums = RestSums::new();
+        self.stance_bridged_at = None;
+    }
+
+    /// [`StrideFlags::BRIDGED`] if an interpolated sample of the stance before heel-off lies
+    /// at or after `start`, the stride's first sample.
+    fn stance_flags(&self, start: u32) -> u16 {
+        match self.stance_bridged_at {
+            Some(at) if at.wrapping_sub(start) < self.heel_off.wrapping_sub(start) => {
+                StrideFlags::BRIDGED
+            }
+            _ => 0,
+        }
     }
 
     /// Feeds sample number `index`: its raw values, its mean-filtered foot-frame
-    /// acceleration `[forward, left, up − g]` (g/2048) and whether the foot is in stance.
-    /// Returns the stride, if any, that this sample lets it report.
+    /// acceleration `[forward, left, up − g]` (g/2048), whether the foot is in stance and
+    /// where the sample came from. Returns the stride, if any, that this sample lets it
+    /// report.
     pub fn process(
         &mut self,
         index: u32,
         s: &RawSample,
         foot: [i16; 3],
         stance: bool,
+        origin: Origin,
     ) -> Option<Stride> {
         self.fed_end = index.wrapping_add(1);
+        let out = self.transition(index, s, foot, stance);
+        if origin != Origin::Measured {
+            self.mark(index, origin);
+        }
+        out
+    }
+
+    /// Notes an interpolated sample in the stance or movement it now belongs to.
+    fn mark(&mut self, index: u32, origin: Origin) {
+        match (self.state, origin) {
+            (State::Moving, Origin::Filled) => {
+                self.flags |= StrideFlags::GAP;
+                let first = self.filled.map_or(index, |f| f.0);
+                self.filled = Some((first, index));
+            }
+            (State::Moving, _) => self.flags |= StrideFlags::BRIDGED,
+            (State::Stance, _) => self.stance_bridged_at = Some(index),
+            // Before the first stance, or in a gap: nothing it could belong to yet.
+            (State::Unprimed | State::Gap, _) => {}
+        }
+    }
+
+    fn transition(
+        &mut self,
+        index: u32,
+        s: &RawSample,
+        foot: [i16; 3],
+        stance: bool,
+    ) -> Option<Stride> {
         match (self.state, stance) {
             (State::Gap, false) => {
                 self.moving_after_gap = self.moving_after_gap.saturating_add(1);
@@ -335,6 +407,7 @@ impl<const M: usize> StrideTracker<M> {
                     self.heel_off = index;
                     self.movement.clear();
                     self.flags = 0;
+                    self.filled = None;
                     self.accumulate_movement(s, foot);
                     return self.pending.take();
                 }
@@ -348,7 +421,11 @@ impl<const M: usize> StrideTracker<M> {
                 let moved = index.wrapping_sub(self.heel_off);
                 self.state = State::Stance;
                 if moved < self.min_movement {
-                    // A wobble: the stance goes on, with its start and sums as they were.
+                    // A wobble: the stance goes on, with its start and sums as they were; a
+                    // hole bridged in the wobble is a hole bridged in the stance.
+                    if self.flags & (StrideFlags::BRIDGED | StrideFlags::GAP) != 0 {
+                        self.stance_bridged_at = Some(index.wrapping_sub(1));
+                    }
                     self.accumulate_stance(s);
                     return None;
                 }
@@ -398,6 +475,19 @@ impl<const M: usize> StrideTracker<M> {
         } else {
             self.stance_start
         };
+        flags |= self.stance_flags(start);
+        let mut toe_off = self.heel_off.wrapping_add(split.toe_off);
+        let mut heel_strike = self.heel_off.wrapping_add(split.heel_strike);
+        if let Some((first, last)) = self.filled {
+            // An event found inside an interpolated hole was not measured.
+            let inside = |e: u32| e.wrapping_sub(first) <= last.wrapping_sub(first);
+            if inside(toe_off) {
+                toe_off = first;
+            }
+            if inside(heel_strike) {
+                heel_strike = first;
+            }
+        }
         let d = self.zupt.displacement();
         let stats = StrideStats::measure(&self.movement, split.toe_off, split.heel_strike);
         let index = self.next_index;
@@ -406,8 +496,8 @@ impl<const M: usize> StrideTracker<M> {
             index,
             start,
             heel_off: self.heel_off,
-            toe_off: self.heel_off.wrapping_add(split.toe_off),
-            heel_strike: self.heel_off.wrapping_add(split.heel_strike),
+            toe_off,
+            heel_strike,
             end: foot_flat,
             length_mm: 0,
             zupt_um: d.horizontal_um.min(u32::MAX as u64) as u32,

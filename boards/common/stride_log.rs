@@ -62,7 +62,7 @@ impl StrideLog {
         self.strides += 1;
         self.distance_mm += s.length_mm as u64;
         defmt::println!(
-            "stride {=u32} t={=u32} dur={=u32} len={=u32} climb={=i32} phases={=u32}/{=u32}/{=u32}/{=u32} ms flags={=u8} idx={=u32},{=u32},{=u32},{=u32},{=u32}",
+            "stride {=u32} t={=u32} dur={=u32} len={=u32} climb={=i32} phases={=u32}/{=u32}/{=u32}/{=u32} ms flags={=u16} idx={=u32},{=u32},{=u32},{=u32},{=u32}",
             s.index,
             self.rate.ms_of_samples(s.start),
             ms(s.start, s.end),

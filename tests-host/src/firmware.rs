@@ -90,7 +90,7 @@ pub struct LoggedStride {
     /// Climb, mm.
     pub climb_mm: i32,
     /// Flag bits.
-    pub flags: u8,
+    pub flags: u16,
 }
 
 /// Parses a line written by `boards/common/stride_log.rs`; `None` for other lines.

@@ -1,7 +1,7 @@
 //! Property tests of the core on arbitrary input: never a panic (overflow checks are on in
 //! tests), state bounded by its constants, and every stride well formed.
 
-use gaitclip::pipeline::{Config, Pipeline};
+use gaitclip::pipeline::{Config, Pipeline, BRIDGE_MAX_MS, FILL_MAX_MS};
 use gaitclip::rate::SampleRate;
 use gaitclip::sample::{AccelRange, GyroRange, RawSample};
 use gaitclip::stride::{Stride, StrideFlags, MAX_STRIDE_MM};
@@ -115,7 +115,8 @@ proptest! {
     }
 
     /// A gap cut anywhere into a real walk: every stride the gap does not touch is the same
-    /// as without it, and the strides it touches are reported once, flagged, without a length.
+    /// as without it, and the stride it touches is reported once and flagged: bridged (still
+    /// measured) when the hole is short, a gap stride without a length when it is long.
     #[test]
     fn a_gap_in_a_walk_costs_only_the_stride_it_falls_in(at in 0usize..6000, missing in 1u32..400) {
         let mut counts = walk();
@@ -136,10 +137,22 @@ proptest! {
                 prop_assert_eq!(c.flags, w.flags);
             }
         }
-        // No stride with a length spans the gap.
+        // Every stride that spans the hole says so: bridged when the hole is short enough
+        // (never a gap then), bridged or a gap (in a stance, or a movement) when it was
+        // filled, a gap when detection restarted after it.
+        let rate = SampleRate::from_hz(200).unwrap();
+        let (bridge, fill) = (rate.samples_in_ms(BRIDGE_MAX_MS), rate.samples_in_ms(FILL_MAX_MS));
         for c in &cut {
             if c.start < at as u32 && c.end > at as u32 {
-                prop_assert!(c.flags.has(StrideFlags::GAP), "{:?} spans the gap at {}..{}", c, at, gap_end);
+                let bridged = c.flags.has(StrideFlags::BRIDGED);
+                let gap = c.flags.has(StrideFlags::GAP);
+                if missing <= bridge {
+                    prop_assert!(bridged && !gap, "{:?} spans the hole at {}..{}", c, at, gap_end);
+                } else if missing <= fill {
+                    prop_assert!(bridged || gap, "{:?} spans the hole at {}..{}", c, at, gap_end);
+                } else {
+                    prop_assert!(gap, "{:?} spans the hole at {}..{}", c, at, gap_end);
+                }
             }
         }
         let gap_strides = cut.iter().filter(|c| c.flags.has(StrideFlags::GAP)).count();
