@@ -46,11 +46,12 @@ pub enum CsvError {
         /// The cell text.
         text: String,
     },
-    /// A timestamp is not later than the one on the line before.
+    /// A timestamp goes back by more than half a period: not a re-sent sample (those are
+    /// dropped and counted), a broken or shuffled recording.
     #[error(
-        "{path}:{line}:{col}: column `t_s`: {t_s} is not after the previous line's {previous_s}"
+        "{path}:{line}:{col}: column `t_s`: {t_s} goes back from the previous sample's {previous_s} by more than half a period"
     )]
-    TimeNotIncreasing {
+    TimeGoesBack {
         /// The file.
         path: PathBuf,
         /// 1-based line number.
@@ -88,24 +89,32 @@ pub enum CsvError {
     },
 }
 
-/// Reads a CSV trace. The rate comes from `rate_hz` if given, else from a `meta.json` beside
-/// the file (`sample_rate_hz`), else from the median interval of `t_s`.
+/// Reads a CSV trace. The nominal rate comes from `rate_hz` if given, else from a
+/// `meta.json` beside the file (`sample_rate_hz`), else from the stamps
+/// ([`crate::clock::nominal_period`]). Re-sent samples (a stamp equal to the one before, or
+/// earlier by less than half a period) are dropped and counted in [`Trace::repeated`].
 pub fn read(path: &Path, rate_hz: Option<f64>) -> Result<Trace, CsvError> {
     let text = fs::read(path).map_err(|source| CsvError::Io {
         path: path.to_owned(),
         source,
     })?;
-    let samples = parse(path, &text)?;
+    let rate_hz = match rate_hz {
+        Some(r) => Some(r),
+        None => meta_rate(path)?,
+    };
+    let rows = parse_rows(path, &text)?;
+    let (samples, repeated) = rows.without_repeats(path, rate_hz)?;
     let rate_hz = match rate_hz {
         Some(r) => r,
-        None => match meta_rate(path)? {
-            Some(r) => r,
-            None => Trace::rate_from_timestamps(&samples).ok_or_else(|| CsvError::Empty {
-                path: path.to_owned(),
-            })?,
-        },
+        None => Trace::rate_from_timestamps(&samples).ok_or_else(|| CsvError::Empty {
+            path: path.to_owned(),
+        })?,
     };
-    Ok(Trace { samples, rate_hz })
+    Ok(Trace {
+        samples,
+        rate_hz,
+        repeated,
+    })
 }
 
 fn meta_rate(csv: &Path) -> Result<Option<f64>, CsvError> {
@@ -130,8 +139,38 @@ fn meta_rate(csv: &Path) -> Result<Option<f64>, CsvError> {
     }
 }
 
-/// Parses CSV bytes; `path` is only used in error messages.
+/// Parses CSV bytes, dropping re-sent samples at the rate the stamps suggest; `path` is
+/// only used in error messages.
 pub fn parse(path: &Path, bytes: &[u8]) -> Result<Vec<ImuSample>, CsvError> {
+    Ok(parse_rows(path, bytes)?.without_repeats(path, None)?.0)
+}
+
+/// Samples as parsed, with the line each came from.
+struct Rows {
+    samples: Vec<ImuSample>,
+    lines: Vec<u64>,
+    /// 1-based column of `t_s`.
+    t_col: usize,
+}
+
+impl Rows {
+    /// The samples without the re-sent ones, and how many those were.
+    fn without_repeats(
+        self,
+        path: &Path,
+        rate_hz: Option<f64>,
+    ) -> Result<(Vec<ImuSample>, usize), CsvError> {
+        Trace::drop_repeats(self.samples, rate_hz).map_err(|e| CsvError::TimeGoesBack {
+            path: path.to_owned(),
+            line: self.lines[e.index],
+            col: self.t_col,
+            t_s: e.t_s,
+            previous_s: e.previous_s,
+        })
+    }
+}
+
+fn parse_rows(path: &Path, bytes: &[u8]) -> Result<Rows, CsvError> {
     let mut rdr = csv::ReaderBuilder::new()
         .has_headers(true)
         .trim(csv::Trim::All)
@@ -154,6 +193,7 @@ pub fn parse(path: &Path, bytes: &[u8]) -> Result<Vec<ImuSample>, CsvError> {
             })?;
     }
     let mut out = Vec::new();
+    let mut lines = Vec::new();
     let mut rec = csv::StringRecord::new();
     loop {
         match rdr.read_record(&mut rec) {
@@ -177,17 +217,7 @@ pub fn parse(path: &Path, bytes: &[u8]) -> Result<Vec<ImuSample>, CsvError> {
                     text: text.to_owned(),
                 })?;
         }
-        if let Some(prev) = out.last().map(|p: &ImuSample| p.t_s) {
-            if v[0] <= prev {
-                return Err(CsvError::TimeNotIncreasing {
-                    path: path.to_owned(),
-                    line,
-                    col: idx[0] + 1,
-                    t_s: v[0],
-                    previous_s: prev,
-                });
-            }
-        }
+        lines.push(line);
         out.push(ImuSample {
             t_s: v[0],
             acc_mps2: [v[1], v[2], v[3]],
@@ -199,7 +229,11 @@ pub fn parse(path: &Path, bytes: &[u8]) -> Result<Vec<ImuSample>, CsvError> {
             path: path.to_owned(),
         });
     }
-    Ok(out)
+    Ok(Rows {
+        samples: out,
+        lines,
+        t_col: idx[0] + 1,
+    })
 }
 
 /// Writes a trace as CSV. Values are printed in Rust's shortest round-trip form, so reading

@@ -1,6 +1,12 @@
 //! `gaitclip eval`: strides, gait events, phases and stance against the ground truth of the
 //! recordings in `../shared/datasets`.
 //!
+//! **Clock.** Everything is compared in the sensor clock's sample numbers, which the core
+//! counts (rows plus the periods lost in holes, [`crate::clock`]): a reference given as a
+//! row is mapped to its number, a reference given as a time (`ipol_gait_events`'
+//! `toe_off_s`/`heel_strike_s`, the walk bounds `walk_*_s`) to the number nearest it on the
+//! recovered clock. Event errors are then whole periods of the sensor, unaffected by holes.
+//!
 //! **Matching.** A detected stride is its movement, heel-off to foot-flat. A reference stride
 //! is the interval its dataset defines (`gaitmap_walk`: mid-stance to mid-stance;
 //! `pyshoe_vicon`: end of stance to end of stance; `ipol_gait_events`: the footstep, toe-off
@@ -31,6 +37,7 @@ use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 use serde::Deserialize;
 
+use crate::clock::SampleClock;
 use crate::csv_trace;
 use crate::trace::{ImuSample, Ranges, Trace};
 
@@ -75,7 +82,24 @@ impl Detected {
     }
 }
 
-/// One reference stride.
+/// Times of a reference's events, s, where the dataset gives them (they override the
+/// rows when mapped to sample numbers).
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct ReferenceTimes {
+    /// Start of the interval holding the stride's movement.
+    pub start_s: Option<f64>,
+    /// Its end.
+    pub end_s: Option<f64>,
+    /// Toe-off.
+    pub toe_off_s: Option<f64>,
+    /// Heel-strike ending the swing.
+    pub heel_strike_s: Option<f64>,
+    /// Heel-strike that began the stride's ground contact.
+    pub prev_heel_strike_s: Option<f64>,
+}
+
+/// One reference stride (rows of the trial's CSV; [`Reference::in_numbers`] maps them to the
+/// sensor clock's sample numbers).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Reference {
     /// Interval that contains the stride's movement.
@@ -92,6 +116,28 @@ pub struct Reference {
     pub prev_heel_strike: Option<u32>,
     /// Reference stride length, m, where the dataset has one.
     pub length_m: Option<f64>,
+    /// Event times, where the dataset gives them.
+    pub times: ReferenceTimes,
+}
+
+impl Reference {
+    /// The reference in sample numbers of `clock`: events given as times go to the nearest
+    /// number, the others from their rows.
+    pub fn in_numbers(&self, clock: &SampleClock) -> Reference {
+        let row = |r: u32| clock.number_of_row(r as usize);
+        let event = |t: Option<f64>, r: Option<u32>| match t {
+            Some(t) => Some(clock.number_at(t)),
+            None => r.map(row),
+        };
+        Reference {
+            start: event(self.times.start_s, Some(self.start)).unwrap_or(0),
+            end: event(self.times.end_s, Some(self.end)).unwrap_or(0),
+            toe_off: event(self.times.toe_off_s, self.toe_off),
+            heel_strike: event(self.times.heel_strike_s, self.heel_strike),
+            prev_heel_strike: event(self.times.prev_heel_strike_s, self.prev_heel_strike),
+            ..*self
+        }
+    }
 }
 
 /// One recording and its ground truth.
@@ -103,8 +149,10 @@ pub struct Trial {
     pub csv: PathBuf,
     /// Reference strides.
     pub references: Vec<Reference>,
-    /// Labelled part of the recording, samples `[from, to)`.
+    /// Labelled part of the recording, rows `[from, to)`.
     pub span: (u32, u32),
+    /// The same bounds as times, s, where the dataset gives them (they override the rows).
+    pub span_s: Option<(f64, f64)>,
     /// Per-sample stance label, where the dataset has one.
     pub stance: Option<Vec<bool>>,
     /// The walker's height, m, where the dataset gives it.
@@ -194,6 +242,7 @@ fn load_strides(dir: &Path, name: &str) -> Result<Vec<Trial>> {
                     .parse()
                     .with_context(|| format!("{}: length_m is not a number", path.display()))?,
             ),
+            times: ReferenceTimes::default(),
         };
         by_trial
             .entry(field(&row, "trial", &path)?.to_string())
@@ -221,6 +270,7 @@ fn load_strides(dir: &Path, name: &str) -> Result<Vec<Trial>> {
             name: trial,
             references,
             span,
+            span_s: None,
             stance,
             height_m: None,
             distance_m: None,
@@ -246,6 +296,7 @@ fn load_ipol(dir: &Path) -> Result<Vec<Trial>> {
                     index(&row, "walk_start_idx", &tpath)?,
                     index(&row, "walk_end_idx", &tpath)?,
                 ),
+                (number(&row, "walk_start_s")?, number(&row, "walk_end_s")?),
                 // Some subjects' heights are not given: left empty.
                 match field(&row, "height_m", &tpath)?.trim() {
                     "" => None,
@@ -257,6 +308,12 @@ fn load_ipol(dir: &Path) -> Result<Vec<Trial>> {
     }
     let epath = dir.join("events.csv");
     let mut by_trial: BTreeMap<(String, String), Vec<(u32, Reference)>> = BTreeMap::new();
+    let seconds = |row: &BTreeMap<String, String>, k: &str| -> Result<f64> {
+        let v = field(row, k, &epath)?;
+        v.trim()
+            .parse()
+            .with_context(|| format!("{}: `{k}` = {v:?} is not a number", epath.display()))
+    };
     for row in read_rows(&epath)? {
         let to = index(&row, "toe_off_idx", &epath)?;
         let hs = index(&row, "heel_strike_idx", &epath)?;
@@ -268,6 +325,16 @@ fn load_ipol(dir: &Path) -> Result<Vec<Trial>> {
             heel_strike: Some(hs),
             prev_heel_strike: None,
             length_m: None,
+            times: {
+                let (to_s, hs_s) = (seconds(&row, "toe_off_s")?, seconds(&row, "heel_strike_s")?);
+                ReferenceTimes {
+                    start_s: Some(to_s),
+                    end_s: Some(hs_s),
+                    toe_off_s: Some(to_s),
+                    heel_strike_s: Some(hs_s),
+                    prev_heel_strike_s: None,
+                }
+            },
         };
         let key = (
             field(&row, "trial", &epath)?.to_string(),
@@ -284,15 +351,18 @@ fn load_ipol(dir: &Path) -> Result<Vec<Trial>> {
         let mut references: Vec<Reference> = steps.into_iter().map(|s| s.1).collect();
         for k in 1..references.len() {
             references[k].prev_heel_strike = references[k - 1].heel_strike;
+            references[k].times.prev_heel_strike_s = references[k - 1].times.heel_strike_s;
         }
-        let (span, height, distance) = *spans
+        let (span, span_s, height, distance) = *spans
             .get(&trial)
             .with_context(|| format!("{}: no trial {trial}", tpath.display()))?;
         trials.push(Trial {
             csv: dir.join(format!("{trial}_{foot}.csv")),
             name: format!("{trial}_{foot}"),
             references,
+            // The rows are the left foot's: the right foot's file has its own holes.
             span,
+            span_s: Some(span_s),
             stance: None,
             height_m: height,
             distance_m: Some(distance),
@@ -481,11 +551,44 @@ pub fn match_strides(det: &[Detected], refs: &[Reference]) -> Vec<(usize, usize)
     out
 }
 
+/// A detector's strides on one trial, in the sample numbers of the trial's recovered
+/// clock (the core's own numbering), and that clock.
+#[derive(Clone, Debug)]
+pub struct Detections {
+    /// The strides.
+    pub strides: Vec<Detected>,
+    /// The trial's sample clock.
+    pub clock: SampleClock,
+}
+
+impl Trial {
+    /// The labelled span in sample numbers of `clock`.
+    pub fn span_in_numbers(&self, clock: &SampleClock) -> (u32, u32) {
+        match self.span_s {
+            Some((a, b)) => (clock.number_at(a), clock.number_at(b)),
+            None => (
+                clock.number_of_row(self.span.0 as usize),
+                clock.number_of_row(self.span.1 as usize),
+            ),
+        }
+    }
+
+    /// The references in sample numbers of `clock` ([`Reference::in_numbers`]).
+    pub fn references_in_numbers(&self, clock: &SampleClock) -> Vec<Reference> {
+        self.references
+            .iter()
+            .map(|r| r.in_numbers(clock))
+            .collect()
+    }
+}
+
 /// Scores one trial's detections.
-pub fn score(trial: &Trial, det: &[Detected], rate_hz: f64) -> Tally {
-    let in_span = |d: &Detected| overlap((d.heel_off, d.end), trial.span) > 0;
-    let det: Vec<Detected> = det.iter().copied().filter(in_span).collect();
-    let refs = &trial.references;
+pub fn score(trial: &Trial, run: &Detections) -> Tally {
+    let clock = &run.clock;
+    let span = trial.span_in_numbers(clock);
+    let in_span = |d: &Detected| overlap((d.heel_off, d.end), span) > 0;
+    let det: Vec<Detected> = run.strides.iter().copied().filter(in_span).collect();
+    let refs = &trial.references_in_numbers(clock);
     let pairs = match_strides(&det, refs);
     let mut t = Tally {
         trials: 1,
@@ -502,7 +605,7 @@ pub fn score(trial: &Trial, det: &[Detected], rate_hz: f64) -> Tally {
     for &(i, j) in &pairs {
         matched_d[i] = Some(j);
     }
-    let ms = |samples: f64| samples * 1000.0 / rate_hz;
+    let ms = |samples: f64| samples * 1000.0 * clock.period_s;
     t.swing.labelled = refs.iter().any(|r| r.toe_off.is_some());
     t.contact.labelled = refs.iter().any(|r| r.prev_heel_strike.is_some());
     for (i, d) in det.iter().enumerate() {
@@ -550,7 +653,10 @@ pub fn score(trial: &Trial, det: &[Detected], rate_hz: f64) -> Tally {
         ph.fn_ = labelled - ph.tp;
     }
     if let Some(label) = &trial.stance {
-        let mut moving = vec![false; label.len()];
+        // Labels are per row; a row is "moving" when its sample number is inside a
+        // detected movement.
+        let numbers = clock.number_of_row(label.len()) as usize + 1;
+        let mut moving = vec![false; numbers];
         for d in &det {
             for m in moving
                 .iter_mut()
@@ -562,8 +668,10 @@ pub fn score(trial: &Trial, det: &[Detected], rate_hz: f64) -> Tally {
         }
         let (mut tp, mut fp, mut fn_) = (0, 0, 0);
         let to = (trial.span.1 as usize).min(label.len());
-        for k in trial.span.0 as usize..to {
-            match (!moving[k], label[k]) {
+        let from = (trial.span.0 as usize).min(to);
+        for (k, &labelled) in label.iter().enumerate().take(to).skip(from) {
+            let n = clock.number_of_row(k) as usize;
+            match (!moving[n], labelled) {
                 (true, true) => tp += 1,
                 (true, false) => fp += 1,
                 (false, true) => fn_ += 1,
@@ -636,7 +744,28 @@ pub fn rotate(samples: &[ImuSample], r: &[[f64; 3]; 3]) -> Vec<ImuSample> {
 }
 
 /// A detector under evaluation: from a trace (counts at `ranges`) to strides.
-pub type Detector<'a> = &'a dyn Fn(&Trace, Ranges) -> Result<Vec<Detected>>;
+pub type Detector<'a> = &'a dyn Fn(&Trace, Ranges) -> Result<Detections>;
+
+/// The core's detector with `config` adjusted by `setup`, as `gaitclip eval` runs it: the
+/// trace is prepared ([`crate::replay::prepare`]: counts, recovered clock, holes) and its
+/// strides reported in sample numbers.
+pub fn core_detector(
+    setup: impl Fn(&mut gaitclip::pipeline::Config),
+) -> impl Fn(&Trace, Ranges) -> Result<Detections> {
+    move |t: &Trace, r: Ranges| {
+        let prepared = crate::replay::prepare(t, r)?;
+        let mut config = prepared.config(r);
+        setup(&mut config);
+        Ok(Detections {
+            strides: prepared
+                .strides(config)
+                .iter()
+                .map(Detected::from)
+                .collect(),
+            clock: prepared.clock,
+        })
+    }
+}
 
 /// Results of one dataset: the tally of the unrotated traces, and one per rotation.
 pub struct DatasetResult {
@@ -661,15 +790,15 @@ pub fn evaluate(
     let mut rotated = vec![Tally::default(); rotations];
     for (k, trial) in dataset.trials.iter().enumerate() {
         let trace = csv_trace::read(&trial.csv, Some(dataset.rate_hz))?;
-        tally.add(&score(trial, &detector(&trace, ranges)?, dataset.rate_hz));
+        tally.add(&score(trial, &detector(&trace, ranges)?));
         let mut rng = ChaCha8Rng::seed_from_u64(seed ^ (k as u64).wrapping_mul(0x9E37_79B9));
         for r in rotated.iter_mut() {
             let m = random_rotation(&mut rng);
             let t = Trace {
                 samples: rotate(&trace.samples, &m),
-                rate_hz: trace.rate_hz,
+                ..trace.clone()
             };
-            r.add(&score(trial, &detector(&t, ranges)?, dataset.rate_hz));
+            r.add(&score(trial, &detector(&t, ranges)?));
         }
     }
     Ok(DatasetResult {

@@ -33,6 +33,7 @@ pub fn csv_reader(data: &[u8]) {
     check_trace(Trace {
         rate_hz: Trace::rate_from_timestamps(&samples).unwrap_or(200.0),
         samples,
+        repeated: 0,
     });
 }
 

@@ -2,6 +2,7 @@
 //! `no_std` core the firmware runs, simulate gait fixtures with ground truth, and run the
 //! firmware in QEMU with its defmt log decoded.
 
+pub mod clock;
 pub mod cost;
 pub mod csv_trace;
 pub mod datasets;
@@ -9,7 +10,7 @@ pub mod eval;
 pub mod firmware;
 pub mod fixtures;
 pub mod fuzzing;
-pub mod gaps;
+
 pub mod length_eval;
 pub mod length_ref;
 pub mod mcap_io;

@@ -21,6 +21,10 @@ pub const ROS2_IMU_SCHEMA: &str = "sensor_msgs/msg/Imu";
 pub const IMU_TOPIC: &str = "/imu";
 /// Topic gaitclip writes strides to.
 pub const STRIDE_TOPIC: &str = "/strides";
+/// Schema name of the replay's summary (JSON, [`crate::replay::Summary`]).
+pub const SUMMARY_SCHEMA: &str = "gaitclip.ReplaySummary";
+/// Topic of the summary: one message at the end.
+pub const SUMMARY_TOPIC: &str = "/summary";
 
 const IMU_JSON_SCHEMA: &str = r#"{"type":"object","title":"gaitclip.ImuSample","properties":{"t_s":{"type":"number","description":"time, s"},"acc":{"type":"array","items":{"type":"number"},"description":"specific force x,y,z, m/s^2, sensor axes"},"gyr":{"type":"array","items":{"type":"number"},"description":"angular rate x,y,z, rad/s"}}}"#;
 const STRIDE_JSON_SCHEMA: &str = r#"{"type":"object","title":"gaitclip.Stride","properties":{"index":{"type":"integer"},"start_s":{"type":"number"},"end_s":{"type":"number"},"length_m":{"type":"number"},"heel_off_s":{"type":"number"},"toe_off_s":{"type":"number"},"heel_strike_s":{"type":"number"},"foot_flat_s":{"type":"number"},"climb_m":{"type":"number"},"valid":{"type":"boolean"},"flags":{"type":"array","items":{"type":"string"}}}}"#;
@@ -422,14 +426,6 @@ pub fn decode(path: &Path, bytes: &[u8], rate_hz: Option<f64>) -> Result<Trace, 
                 {
                     return Err(bad("non-finite value".into()));
                 }
-                if let Some(prev) = samples.last() {
-                    if s.t_s <= prev.t_s {
-                        return Err(bad(format!(
-                            "time {} s is not after the previous message's {} s",
-                            s.t_s, prev.t_s
-                        )));
-                    }
-                }
                 samples.push(s);
             }
         }
@@ -452,10 +448,27 @@ pub fn decode(path: &Path, bytes: &[u8], rate_hz: Option<f64>) -> Result<Trace, 
             seen,
         });
     }
+    let topic = chosen
+        .and_then(|(id, _)| channels.get(&id))
+        .map_or("", |c| c.0);
+    let (samples, repeated) =
+        Trace::drop_repeats(samples, rate_hz).map_err(|e| McapError::BadMessage {
+            path: path.to_owned(),
+            index: e.index,
+            topic: topic.to_owned(),
+            message: format!(
+                "time {} s goes back from the previous message's {} s by more than half a period",
+                e.t_s, e.previous_s
+            ),
+        })?;
     let rate_hz = rate_hz
         .or_else(|| Trace::rate_from_timestamps(&samples))
         .unwrap_or(0.0);
-    Ok(Trace { samples, rate_hz })
+    Ok(Trace {
+        samples,
+        rate_hz,
+        repeated,
+    })
 }
 
 /// Decodes a CDR-encoded ROS 2 `sensor_msgs/msg/Imu`: header stamp, frame id, orientation
@@ -569,11 +582,13 @@ fn ns(t_s: f64) -> u64 {
     (t_s.max(0.0) * 1e9).round() as u64
 }
 
-/// Writes `samples` on [`IMU_TOPIC`] and one message per stride on [`STRIDE_TOPIC`].
+/// Writes `samples` on [`IMU_TOPIC`], one message per stride on [`STRIDE_TOPIC`] and, when
+/// given, the replay's summary on [`SUMMARY_TOPIC`] (stamped at the last sample).
 pub fn write<W: Write + Seek>(
     w: W,
     samples: &[ImuSample],
     strides: &[StrideReport],
+    summary: Option<&crate::replay::Summary>,
 ) -> Result<(), McapError> {
     let e = McapError::Write;
     let mut out = mcap::WriteOptions::new()
@@ -616,6 +631,28 @@ pub fn write<W: Write + Seek>(
             sequence: s.index,
             log_time: ns(s.end_s),
             publish_time: ns(s.end_s),
+        };
+        out.write_to_known_channel(&h, &data).map_err(e)?;
+    }
+    if let Some(summary) = summary {
+        let schema = out
+            .add_schema(
+                SUMMARY_SCHEMA,
+                "jsonschema",
+                br#"{"type":"object","title":"gaitclip.ReplaySummary"}"#,
+            )
+            .map_err(e)?;
+        let ch = out
+            .add_channel(schema, SUMMARY_TOPIC, "json", &meta)
+            .map_err(e)?;
+        let data = serde_json::to_vec(summary)
+            .map_err(|x| McapError::Write(mcap::McapError::Io(x.into())))?;
+        let t = samples.last().map_or(0, |s| ns(s.t_s));
+        let h = mcap::records::MessageHeader {
+            channel_id: ch,
+            sequence: 0,
+            log_time: t,
+            publish_time: t,
         };
         out.write_to_known_channel(&h, &data).map_err(e)?;
     }

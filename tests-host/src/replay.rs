@@ -5,13 +5,13 @@ use std::collections::BTreeMap;
 
 use gaitclip::features::Features;
 use gaitclip::models::{self, Model};
-use gaitclip::pipeline::{Config, Detector, Pipeline};
+use gaitclip::pipeline::{Config, Detector, HoleCounts, Pipeline};
 use gaitclip::rate::SampleRate;
 use gaitclip::sample::RawSample;
 use gaitclip::stride::{Stride, StrideFlags};
 use serde::Serialize;
 
-use crate::gaps::{self, Gap, GapClock};
+use crate::clock::{Gap, SampleClock, TimeGoesBack};
 use crate::trace::{Ranges, Trace};
 
 /// Why a trace cannot be replayed.
@@ -20,9 +20,98 @@ pub enum ReplayError {
     /// The rate is outside what the core supports.
     #[error("sample rate {0} Hz is outside 100–1000 Hz")]
     Rate(f64),
-    /// The timestamps go backwards or repeat.
+    /// The trace has no samples.
+    #[error("no samples")]
+    Empty,
+    /// The timestamps go back by more than a re-sent sample's.
     #[error(transparent)]
-    Time(#[from] crate::gaps::TimeError),
+    Time(#[from] TimeGoesBack),
+}
+
+/// What was done to a recording's samples before and while the core measured them: the
+/// last line or record of `replay`.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct Summary {
+    /// Samples read from the file.
+    pub samples_read: usize,
+    /// Re-sent samples dropped (a repeated stamp).
+    pub repeated_dropped: usize,
+    /// Holes found in the stamps.
+    pub holes: usize,
+    /// Sample periods lost in them.
+    pub lost_samples: u64,
+    /// Holes bridged by interpolation (short enough to measure through), and their samples.
+    pub bridged: u32,
+    /// Samples interpolated across the bridged holes.
+    pub bridged_samples: u32,
+    /// Holes that are gaps (strides across them have no length), and their samples.
+    pub gaps: u32,
+    /// Samples lost in the gaps.
+    pub gap_samples: u32,
+    /// Of the gaps, those still interpolated so that events outside them are found.
+    pub gaps_filled: u32,
+    /// Strides reported, and how many of them are valid.
+    pub strides: usize,
+    /// Valid strides.
+    pub valid_strides: usize,
+    /// Strides flagged bridged.
+    pub bridged_strides: usize,
+    /// Gap strides.
+    pub gap_strides: usize,
+    /// Summed length of the valid strides, m.
+    pub distance_m: f64,
+    /// The nominal rate (`--rate`, `meta.json`, or the stamps), Hz.
+    pub nominal_rate_hz: f64,
+    /// The sensor clock recovered from the stamps: rate, Hz…
+    pub clock_rate_hz: f64,
+    /// …and the time of the first sample, s.
+    pub clock_offset_s: f64,
+    /// The rate the core ran at (the clock's, to the millihertz), Hz.
+    pub core_rate_hz: f64,
+    /// Stamps more than a quarter period off the recovered clock (re-timed onto it).
+    pub retimed_stamps: usize,
+    /// The farthest a stamp lay from the clock, ms.
+    pub max_stamp_offset_ms: f64,
+}
+
+impl Summary {
+    /// The summary as one line of text.
+    pub fn line(&self) -> String {
+        let mut s = format!(
+            "summary: {} strides ({} valid, {} bridged, {} gap), {:.3} m; {} samples read, {} repeated dropped; {} holes ({} samples lost): {} bridged ({} samples), {} gaps ({} samples, {} of them filled for their events); clock {:.4} Hz (nominal {:.4} Hz, {:+.1} ppm), first sample at {:.6} s, core at {:.3} Hz",
+            self.strides,
+            self.valid_strides,
+            self.bridged_strides,
+            self.gap_strides,
+            self.distance_m,
+            self.samples_read,
+            self.repeated_dropped,
+            self.holes,
+            self.lost_samples,
+            self.bridged,
+            self.bridged_samples,
+            self.gaps,
+            self.gap_samples,
+            self.gaps_filled,
+            self.clock_rate_hz,
+            self.nominal_rate_hz,
+            (self.clock_rate_hz / self.nominal_rate_hz - 1.0) * 1e6,
+            // No "-0.000000 s" for an offset that is zero to print precision.
+            if self.clock_offset_s.abs() < 5e-7 {
+                0.0
+            } else {
+                self.clock_offset_s
+            },
+            self.core_rate_hz,
+        );
+        if self.retimed_stamps > 0 {
+            s += &format!(
+                "; re-timed: {} stamps off the clock by more than a quarter period (at most {:.2} ms)",
+                self.retimed_stamps, self.max_stamp_offset_ms
+            );
+        }
+        s
+    }
 }
 
 /// A stride as the host reports it.
@@ -92,6 +181,9 @@ pub fn flag_names(f: StrideFlags) -> Vec<&'static str> {
     if f.has(StrideFlags::IMPLAUSIBLE) {
         v.push("implausible");
     }
+    if f.has(StrideFlags::BRIDGED) {
+        v.push("bridged");
+    }
     v
 }
 
@@ -115,6 +207,11 @@ pub fn core_strides(samples: &[RawSample], config: Config) -> Vec<Stride> {
 /// The core's strides for raw counts with `gaps` (sorted by position) declared to it as
 /// the firmware declares a FIFO overflow.
 pub fn core_strides_gapped(samples: &[RawSample], gaps: &[Gap], config: Config) -> Vec<Stride> {
+    core_run(samples, gaps, config).0
+}
+
+/// [`core_strides_gapped`], and what the core did with the holes.
+pub fn core_run(samples: &[RawSample], gaps: &[Gap], config: Config) -> (Vec<Stride>, HoleCounts) {
     let mut p = Pipeline::new(config);
     let mut strides = Vec::new();
     let mut next_gap = gaps.iter().peekable();
@@ -128,21 +225,96 @@ pub fn core_strides_gapped(samples: &[RawSample], gaps: &[Gap], config: Config) 
     while let Some(s) = p.take() {
         strides.push(s);
     }
-    strides
+    (strides, p.holes())
 }
 
-/// The raw counts of a trace at `ranges`, the gaps in its timestamps and the sample rate,
-/// ready for [`core_strides_gapped`].
-pub fn prepare(
-    trace: &Trace,
-    ranges: Ranges,
-) -> Result<(Vec<RawSample>, Vec<Gap>, SampleRate), ReplayError> {
-    let rate = trace
-        .sample_rate()
-        .ok_or(ReplayError::Rate(trace.rate_hz))?;
-    let gaps = gaps::find(&trace.samples, trace.rate_hz)?;
-    let counts = trace.samples.iter().map(|s| ranges.to_counts(s)).collect();
-    Ok((counts, gaps, rate))
+/// A trace made ready for the core: its counts, its recovered sample clock (with the holes
+/// in its stamps) and the core's rate (the clock's, to the millihertz).
+#[derive(Clone, Debug)]
+pub struct Prepared {
+    /// Counts at the ranges asked for, one per row (re-sent samples dropped).
+    pub counts: Vec<RawSample>,
+    /// The sensor clock.
+    pub clock: SampleClock,
+    /// The rate the core runs at.
+    pub rate: SampleRate,
+    /// Rows read and re-sent samples dropped.
+    read: (usize, usize),
+    nominal_hz: f64,
+}
+
+impl Prepared {
+    /// The core's strides with `config`, the holes declared where the clock found them.
+    pub fn strides(&self, config: Config) -> Vec<Stride> {
+        core_strides_gapped(&self.counts, &self.clock.holes, config)
+    }
+
+    /// [`Prepared::strides`] and the summary of what was done to the samples.
+    pub fn run(&self, config: Config) -> (Vec<Stride>, Summary) {
+        let (strides, h) = core_run(&self.counts, &self.clock.holes, config);
+        let summary = Summary {
+            samples_read: self.read.0,
+            repeated_dropped: self.read.1,
+            holes: self.clock.holes.len(),
+            lost_samples: self.clock.lost(),
+            bridged: h.bridged,
+            bridged_samples: h.bridged_samples,
+            gaps: h.gaps(),
+            gap_samples: h.gap_samples(),
+            gaps_filled: h.filled,
+            strides: strides.len(),
+            valid_strides: strides.iter().filter(|s| s.flags.valid()).count(),
+            bridged_strides: strides
+                .iter()
+                .filter(|s| s.flags.has(StrideFlags::BRIDGED))
+                .count(),
+            gap_strides: strides
+                .iter()
+                .filter(|s| s.flags.has(StrideFlags::GAP))
+                .count(),
+            distance_m: strides
+                .iter()
+                .filter(|s| s.flags.valid())
+                .map(|s| s.length_mm as f64 / 1000.0)
+                .sum(),
+            nominal_rate_hz: self.nominal_hz,
+            clock_rate_hz: self.clock.rate_hz(),
+            clock_offset_s: self.clock.offset_s,
+            core_rate_hz: self.rate.millihertz() as f64 / 1000.0,
+            retimed_stamps: self.clock.retimed,
+            max_stamp_offset_ms: self.clock.max_offclock_s * 1e3,
+        };
+        (strides, summary)
+    }
+
+    /// The default configuration at the core's rate and `ranges`.
+    pub fn config(&self, ranges: Ranges) -> Config {
+        Config::new(self.rate, ranges.accel, ranges.gyro)
+    }
+}
+
+/// A trace ready for the core ([`Prepared`]): converted to counts at `ranges`, its sample
+/// clock recovered from its stamps ([`crate::clock`]).
+pub fn prepare(trace: &Trace, ranges: Ranges) -> Result<Prepared, ReplayError> {
+    let (samples, repeated) = Trace::drop_repeats(trace.samples.clone(), Some(trace.rate_hz))?;
+    let stamps: Vec<f64> = samples.iter().map(|s| s.t_s).collect();
+    let mut clock = SampleClock::recover(&stamps, Some(trace.rate_hz)).ok_or(ReplayError::Empty)?;
+    let mhz = (clock.rate_hz() * 1000.0).round();
+    let rate = SampleRate::from_millihertz(mhz.clamp(0.0, u32::MAX as f64) as u32)
+        .ok_or(ReplayError::Rate(clock.rate_hz()))?;
+    let counts: Vec<RawSample> = samples.iter().map(|s| ranges.to_counts(s)).collect();
+    // Holes inside a host's bursts, placed by the angular rate.
+    clock.place_holes(&stamps, |row| counts[row].gyro.map(|v| v as f64));
+    Ok(Prepared {
+        counts,
+        clock,
+        rate,
+        read: (
+            trace.samples.len() + trace.repeated,
+            trace.repeated + repeated,
+        ),
+        nominal_hz: trace.rate_hz,
+    })
 }
 
 /// Replays raw counts through the core configured by `config`.
@@ -179,12 +351,25 @@ pub fn replay_model(
     model: Model,
     all_models: bool,
 ) -> Result<Vec<StrideReport>, ReplayError> {
-    let (counts, gaps, rate) = prepare(trace, ranges)?;
-    let clock = GapClock::new(&trace.samples, &gaps, trace.rate_hz);
-    let mut config = Config::new(rate, ranges.accel, ranges.gyro);
+    Ok(replay_summarised(trace, ranges, detector, model, all_models)?.0)
+}
+
+/// [`replay_model`], with the summary of what was done to the samples.
+pub fn replay_summarised(
+    trace: &Trace,
+    ranges: Ranges,
+    detector: Detector,
+    model: Model,
+    all_models: bool,
+) -> Result<(Vec<StrideReport>, Summary), ReplayError> {
+    let prepared = prepare(trace, ranges)?;
+    let rate = prepared.rate;
+    let mut config = prepared.config(ranges);
     config.model = model;
     config.detector = detector;
-    let mut out: Vec<StrideReport> = core_strides_gapped(&counts, &gaps, config)
+    let (strides, summary) = prepared.run(config);
+    let clock = &prepared.clock;
+    let mut out: Vec<StrideReport> = strides
         .into_iter()
         .map(|s| report(s, config, &|n| clock.t_s(n)))
         .collect();
@@ -206,7 +391,7 @@ pub fn replay_model(
             );
         }
     }
-    Ok(out)
+    Ok((out, summary))
 }
 
 fn report(s: Stride, config: Config, t_s: &impl Fn(u32) -> f64) -> StrideReport {

@@ -22,8 +22,12 @@ pub struct ImuSample {
 pub struct Trace {
     /// The samples, in time order.
     pub samples: Vec<ImuSample>,
-    /// Nominal sample rate, Hz.
+    /// Nominal sample rate, Hz (`--rate`, `meta.json`, or estimated from the stamps); the
+    /// replay recovers the sensor's own clock from the stamps ([`crate::clock`]).
     pub rate_hz: f64,
+    /// Samples dropped by the reader as re-sent: a stamp equal to the one before, or
+    /// earlier by less than half a period ([`crate::clock::drop_repeats`]).
+    pub repeated: usize,
 }
 
 /// Sensor ranges used to turn physical units into counts.
@@ -85,17 +89,29 @@ impl Trace {
         SampleRate::from_millihertz((self.rate_hz * 1000.0).round() as u32)
     }
 
-    /// Estimates the rate from the median sample interval.
+    /// Estimates the nominal rate from the stamps ([`crate::clock::nominal_period`]).
     pub fn rate_from_timestamps(samples: &[ImuSample]) -> Option<f64> {
-        let mut dts: Vec<f64> = samples
-            .windows(2)
-            .map(|w| w[1].t_s - w[0].t_s)
-            .filter(|d| d.is_finite() && *d > 0.0)
-            .collect();
-        if dts.is_empty() {
-            return None;
+        let t: Vec<f64> = samples.iter().map(|s| s.t_s).collect();
+        crate::clock::nominal_period(&t).map(|p| 1.0 / p)
+    }
+
+    /// Drops re-sent samples ([`crate::clock::drop_repeats`] at the nominal rate, or at
+    /// the rate the stamps suggest when it is not known yet), counting them in
+    /// [`Trace::repeated`]. On a stamp that goes back further, the index of its sample.
+    pub fn drop_repeats(
+        samples: Vec<ImuSample>,
+        rate_hz: Option<f64>,
+    ) -> Result<(Vec<ImuSample>, usize), crate::clock::TimeGoesBack> {
+        let t: Vec<f64> = samples.iter().map(|s| s.t_s).collect();
+        let period = match rate_hz {
+            Some(r) if r > 0.0 => 1.0 / r,
+            _ => crate::clock::nominal_period(&t).unwrap_or(0.0),
+        };
+        let keep = crate::clock::drop_repeats(&t, period)?;
+        let dropped = samples.len() - keep.len();
+        if dropped == 0 {
+            return Ok((samples, 0));
         }
-        dts.sort_by(f64::total_cmp);
-        Some(1.0 / dts[dts.len() / 2])
+        Ok((keep.into_iter().map(|i| samples[i]).collect(), dropped))
     }
 }

@@ -23,7 +23,7 @@ use anyhow::{bail, Context, Result};
 use gaitclip::features::{self, Features, COUNT, PER_SEGMENT, ZUPT_LENGTH};
 use gaitclip::models::{Model, ModelParams, Settings, LINEAR_MODELS, MAX_TERMS};
 use gaitclip::phase_stats::{Channel, Segment};
-use gaitclip::pipeline::{Config, DEFAULT_MODEL};
+use gaitclip::pipeline::DEFAULT_MODEL;
 use gaitclip::rate::SampleRate;
 use gaitclip::stride::Stride;
 use gaitclip::svr::{Boosted, Svr};
@@ -82,26 +82,28 @@ pub struct TrialRun {
 /// Replays every trial of `dataset` through the core.
 pub fn run_dataset(dataset: &Dataset) -> Result<Vec<TrialRun>> {
     let ranges = Ranges::default();
-    let rate = SampleRate::from_millihertz((dataset.rate_hz * 1000.0).round() as u32)
-        .with_context(|| format!("{}: unsupported rate {}", dataset.name, dataset.rate_hz))?;
     let mut out = Vec::new();
     for trial in &dataset.trials {
         let trace = csv_trace::read(&trial.csv, Some(dataset.rate_hz))?;
-        let counts: Vec<_> = trace.samples.iter().map(|s| ranges.to_counts(s)).collect();
-        let all = replay::core_strides(&counts, Config::new(rate, ranges.accel, ranges.gyro));
+        let prepared =
+            replay::prepare(&trace, ranges).with_context(|| format!("{}", trial.csv.display()))?;
+        let rate = prepared.rate;
+        let all = prepared.strides(prepared.config(ranges));
+        let span = trial.span_in_numbers(&prepared.clock);
+        let references = trial.references_in_numbers(&prepared.clock);
         let strides: Vec<Stride> = all
             .into_iter()
             // A stride belongs to the span when its movement's middle does: a first step
             // that ends just inside the reference's first stride is not in it.
             .filter(|s| {
                 let mid = s.heel_off / 2 + s.end / 2;
-                mid >= trial.span.0 && mid < trial.span.1
+                mid >= span.0 && mid < span.1
             })
             .collect();
         let det: Vec<Detected> = strides.iter().map(Detected::from).collect();
         let mut reference = vec![None; strides.len()];
-        for (i, j) in eval::match_strides(&det, &trial.references) {
-            let r = &trial.references[j];
+        for (i, j) in eval::match_strides(&det, &references) {
+            let r = &references[j];
             if !r.flagged && strides[i].flags.valid() {
                 reference[i] = r.length_m;
             }

@@ -56,14 +56,52 @@ fn a_missing_column_is_bad_input_and_named() {
 fn time_going_back_is_bad_input_with_its_line() {
     let p = tmp(
         "time.csv",
-        format!("{HEADER}0,0,0,9.8,0,0,0\n0.005,0,0,9.8,0,0,0\n0.004,0,0,9.8,0,0,0\n").as_bytes(),
+        format!("{HEADER}0,0,0,9.8,0,0,0\n0.005,0,0,9.8,0,0,0\n0.010,0,0,9.8,0,0,0\n0.001,0,0,9.8,0,0,0\n")
+            .as_bytes(),
     );
-    let (code, err) = gaitclip(&["replay", p.to_str().unwrap()]);
+    let (code, err) = gaitclip(&["replay", p.to_str().unwrap(), "--rate", "200"]);
     assert_eq!(code, Some(65), "{err}");
     assert!(
-        err.contains(&format!("{}:4:1: column `t_s`", p.display())),
+        err.contains(&format!(
+            "{}:5:1: column `t_s`: 0.001 goes back from the previous sample's 0.01",
+            p.display()
+        )),
         "{err}"
     );
+    let _ = std::fs::remove_file(p);
+}
+
+/// A re-sent sample (the same stamp again) is dropped, counted and reported in the summary,
+/// in text and in JSON; the replay goes on.
+#[test]
+fn a_repeated_sample_is_dropped_and_reported() {
+    let mut text = String::from(HEADER);
+    for i in 0..400 {
+        text += &format!("{},0,0,9.80665,0,0,0\n", i as f64 * 0.005);
+        if i == 100 {
+            text += &format!("{},0.1,0,9.80665,0,0,0\n", i as f64 * 0.005);
+        }
+    }
+    let p = tmp("repeat.csv", text.as_bytes());
+    let out = Command::new(env!("CARGO_BIN_EXE_gaitclip"))
+        .args(["replay", p.to_str().unwrap(), "--rate", "200"])
+        .output()
+        .unwrap();
+    assert_eq!(out.status.code(), Some(0));
+    let stdout = String::from_utf8_lossy(&out.stdout);
+    let last = stdout.lines().last().unwrap_or("");
+    assert!(
+        last.starts_with("summary:") && last.contains("401 samples read, 1 repeated dropped"),
+        "{stdout}"
+    );
+    let out = Command::new(env!("CARGO_BIN_EXE_gaitclip"))
+        .args(["replay", p.to_str().unwrap(), "--rate", "200", "--json"])
+        .output()
+        .unwrap();
+    let stdout = String::from_utf8_lossy(&out.stdout);
+    let v: serde_json::Value = serde_json::from_str(stdout.lines().last().unwrap()).unwrap();
+    assert_eq!(v["summary"]["repeated_dropped"], 1, "{stdout}");
+    assert_eq!(v["summary"]["samples_read"], 401, "{stdout}");
     let _ = std::fs::remove_file(p);
 }
 

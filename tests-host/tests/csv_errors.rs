@@ -65,10 +65,27 @@ fn header_only_is_empty() {
 
 #[test]
 fn time_going_back_names_line_and_column() {
-    let text = "acc_x,t_s,acc_y,acc_z,gyr_x,gyr_y,gyr_z\n1,0.010,2,3,4,5,6\n1,0.015,2,3,4,5,6\n1,0.015,2,3,4,5,6\n";
+    let text = "acc_x,t_s,acc_y,acc_z,gyr_x,gyr_y,gyr_z\n1,0.010,2,3,4,5,6\n1,0.015,2,3,4,5,6\n1,0.020,2,3,4,5,6\n1,0.012,2,3,4,5,6\n";
     let e = parse(Path::new("w.csv"), text.as_bytes()).unwrap_err();
     assert_eq!(
         e.to_string(),
-        "w.csv:4:2: column `t_s`: 0.015 is not after the previous line's 0.015"
+        "w.csv:5:2: column `t_s`: 0.012 goes back from the previous sample's 0.02 by more than half a period"
+    );
+}
+
+/// A stamp equal to the one before, or earlier by less than half a period, is a re-sent
+/// sample: the first is kept, the repeat dropped.
+#[test]
+fn a_repeated_stamp_is_dropped_not_fatal() {
+    let text = "t_s,acc_x,acc_y,acc_z,gyr_x,gyr_y,gyr_z\n0.010,1,2,3,4,5,6\n0.015,1,2,3,4,5,6\n0.015,9,9,9,9,9,9\n0.0149,8,8,8,8,8,8\n0.020,1,2,3,4,5,6\n";
+    let s = parse(Path::new("w.csv"), text.as_bytes()).unwrap();
+    assert_eq!(
+        s.iter().map(|s| s.t_s).collect::<Vec<_>>(),
+        vec![0.010, 0.015, 0.020]
+    );
+    assert_eq!(
+        s[1].acc_mps2,
+        [1.0, 2.0, 3.0],
+        "the first of the repeats is kept"
     );
 }

@@ -93,21 +93,11 @@ fn gaitmap_walk_strides_and_lengths() {
 /// that a regression fails here.
 #[test]
 fn eval_figures_on_recordings() {
-    use gaitclip::pipeline::Config;
-    use gaitclip_host::eval::{self, abs_quantile, Detected};
-    use gaitclip_host::replay::core_strides;
-    use gaitclip_host::trace::{Ranges, Trace};
+    use gaitclip_host::eval::{self, abs_quantile};
     let Some(root) = gaitclip_host::datasets::root_or_skip("eval_figures_on_recordings") else {
         return;
     };
-    let detector = |t: &Trace, r: Ranges| -> anyhow::Result<Vec<Detected>> {
-        let config = Config::new(t.sample_rate().unwrap(), r.accel, r.gyro);
-        let counts: Vec<_> = t.samples.iter().map(|s| r.to_counts(s)).collect();
-        Ok(core_strides(&counts, config)
-            .iter()
-            .map(Detected::from)
-            .collect())
-    };
+    let detector = eval::core_detector(|_| {});
     // (dataset, min F1, max median |toe-off|, |heel-strike| ms, min swing IoU)
     for (name, f1, to, hs, iou) in [
         ("gaitmap_walk", 0.97, 30.0, 70.0, 0.80),

@@ -28,6 +28,7 @@ fn written_mcap_replays_to_the_same_strides() {
         std::fs::File::create(&path).unwrap(),
         &trace.samples,
         &strides,
+        None,
     )
     .unwrap();
     let back = mcap_io::read(&path, None).unwrap();

@@ -7,7 +7,7 @@ use clap::{Parser, Subcommand};
 use gaitclip::models::Model;
 use gaitclip::phases::PhaseMethod;
 use gaitclip::pipeline::{Config, Detector};
-use gaitclip_host::eval::{self, Detected};
+use gaitclip_host::eval;
 use gaitclip_host::trace::{Ranges, Trace};
 use gaitclip_host::{csv_trace, fixtures, length_eval, mcap_io, replay, train};
 
@@ -160,8 +160,8 @@ struct WriteError {
 
 /// The exit status for an error: by the first typed cause in its chain.
 fn status_of(e: &anyhow::Error) -> u8 {
+    use gaitclip_host::clock::TimeGoesBack;
     use gaitclip_host::csv_trace::CsvError;
-    use gaitclip_host::gaps::TimeError;
     use gaitclip_host::mcap_io::McapError;
     for cause in e.chain() {
         if let Some(c) = cause.downcast_ref::<CsvError>() {
@@ -177,7 +177,7 @@ fn status_of(e: &anyhow::Error) -> u8 {
                 _ => status::BAD_INPUT,
             };
         }
-        if cause.is::<replay::ReplayError>() || cause.is::<TimeError>() {
+        if cause.is::<replay::ReplayError>() || cause.is::<TimeGoesBack>() {
             return status::BAD_INPUT;
         }
         if cause.is::<WriteError>() {
@@ -244,8 +244,9 @@ fn run(cli: Cli) -> anyhow::Result<()> {
                 .into());
             }
             let t = read_trace(&trace, rate)?;
-            let strides = replay::replay_model(&t, Ranges::default(), detector, model, all_models)
-                .with_context(|| trace.display().to_string())?;
+            let (strides, summary) =
+                replay::replay_summarised(&t, Ranges::default(), detector, model, all_models)
+                    .with_context(|| trace.display().to_string())?;
             for s in &strides {
                 if json {
                     println!("{}", serde_json::to_string(s)?);
@@ -269,14 +270,25 @@ fn run(cli: Cli) -> anyhow::Result<()> {
                     }
                 }
             }
-            let total: f64 = strides.iter().map(|s| s.length_m).sum();
-            eprintln!("{} strides, {:.3} m in total", strides.len(), total);
+            if json {
+                println!(
+                    "{}",
+                    serde_json::to_string(&serde_json::json!({ "summary": summary }))?
+                );
+            } else {
+                println!("{}", summary.line());
+            }
             if let Some(out) = mcap_out {
                 let f = std::fs::File::create(&out).map_err(|source| WriteError {
                     path: out.clone(),
                     source,
                 })?;
-                mcap_io::write(std::io::BufWriter::new(f), &t.samples, &strides)?;
+                mcap_io::write(
+                    std::io::BufWriter::new(f),
+                    &t.samples,
+                    &strides,
+                    Some(&summary),
+                )?;
                 eprintln!("wrote {}", out.display());
             }
         }
@@ -288,17 +300,10 @@ fn run(cli: Cli) -> anyhow::Result<()> {
             plots,
         } => {
             let run_with = |which: Detector| {
-                move |t: &Trace, r: Ranges| -> anyhow::Result<Vec<Detected>> {
-                    let (counts, gaps, rate) = replay::prepare(t, r)?;
-                    let mut config = Config::new(rate, r.accel, r.gyro);
-                    config.phases = phases.into();
-                    config.detector = which;
-                    let clock = gaitclip_host::gaps::GapClock::new(&t.samples, &gaps, t.rate_hz);
-                    Ok(replay::core_strides_gapped(&counts, &gaps, config)
-                        .iter()
-                        .map(|s| Detected::from(s).map(|n| clock.recording_index(n)))
-                        .collect())
-                }
+                eval::core_detector(move |c: &mut Config| {
+                    c.phases = phases.into();
+                    c.detector = which;
+                })
             };
             let (stance, lu) = (run_with(Detector::Stance), run_with(Detector::PeakValley));
             let mut results = Vec::new();
