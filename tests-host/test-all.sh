@@ -7,10 +7,15 @@
 # ../shared/datasets is present, the bit-exact QEMU runs of the M4 and M0 firmware, and the instruction counts of
 # the cost benchmark). The cost figures themselves come from tests-host/cost.sh.
 # Installs what a fresh Debian machine lacks: qemu-system-arm (apt) and flip-link (cargo).
-# rustup installs the toolchain, targets and components named in rust-toolchain.toml.
+# rustup installs the toolchain, targets and components named in rust-toolchain.toml; where
+# that toolchain is already installed without them, rustup does not add them on its own, so
+# the script asks it to (quick and idempotent when everything is there).
 set -euo pipefail
 root=$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)
 cd "$root"
+
+echo "== toolchain: $(grep '^channel' rust-toolchain.toml) with its targets and components"
+rustup toolchain install
 
 bash "$root/boards/install-qemu"
 # The boards link through flip-link (stack-overflow protection); cargo installs it.
