@@ -23,6 +23,7 @@
 //!                                                          step ─→ D, f ─→ fuzzy k ─→ Weinberg
 //! ```
 
+use crate::bridge;
 use crate::features::Features;
 use crate::foot_frame::FootFrameEstimator;
 use crate::mean_filter::MeanFilter;
@@ -51,7 +52,7 @@ pub const DELAY_CAPACITY: usize = 128;
 /// arrives, the stride it falls in flagged [`StrideFlags::BRIDGED`] and still measured.
 /// Chosen by measurement (`gaitclip holes`, the README's hole table): the longest hole
 /// whose mean |length error| against the uncut recordings stays ≤ 1 cm.
-pub const BRIDGE_MAX_MS: u32 = 40;
+pub const BRIDGE_MAX_MS: u32 = 30;
 /// Longest hole interpolated at all. A longer hole than [`BRIDGE_MAX_MS`], up to this, is
 /// filled too so that the stride's events outside it are still found, but a stride whose
 /// movement it falls in is a [`StrideFlags::GAP`] stride without a length. Anything longer
@@ -191,11 +192,14 @@ impl HoleCounts {
     }
 }
 
-/// A hole waiting for the sample after it, to be interpolated across.
+/// A hole waiting for the samples after it, to be interpolated across.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 struct PendingHole {
     missing: u32,
     origin: Origin,
+    /// A bridged hole waits for two samples after it (a cubic through two samples either
+    /// side): the first of them, held until the second arrives.
+    after: Option<RawSample>,
 }
 
 /// What one call's samples released, not yet measured.
@@ -308,6 +312,7 @@ impl<const M: usize> Pipeline<M> {
             hole: PendingHole {
                 missing: 0,
                 origin: Origin::Measured,
+                after: None,
             },
             holes: HoleCounts {
                 bridged: 0,
@@ -351,20 +356,53 @@ impl<const M: usize> Pipeline<M> {
     }
 
     /// Feeds one sample; returns a stride when one can be reported. After a hole that
-    /// [`Pipeline::gap`] keeps for bridging, the samples it lost are first interpolated
-    /// between the last sample and this one.
+    /// [`Pipeline::gap`] keeps, the samples it lost are first interpolated: a bridged hole
+    /// by the cubic through the two samples either side of it (this sample is then held
+    /// until the next one arrives, one sample period late), a filled one on the straight
+    /// line between the samples either side.
     pub fn process(&mut self, s: &RawSample) -> Option<Stride> {
-        let hole = core::mem::take(&mut self.hole);
         let mut out = Released::Nothing;
-        if hole.missing > 0 {
-            let last = self.raw_line[slot(self.next.wrapping_sub(1))];
-            for k in 1..=hole.missing {
-                let x = interpolate(&last, s, k, hole.missing + 1);
-                self.step(&x, hole.origin, &mut out);
+        if self.hole.missing > 0 {
+            if self.hole.origin == Origin::Bridged
+                && self.hole.after.is_none()
+                && self.since_reset >= 2
+            {
+                self.hole.after = Some(*s);
+                return None;
             }
+            let hole = core::mem::take(&mut self.hole);
+            self.fill(hole, Some(s), &mut out);
+        } else {
+            self.step(s, Origin::Measured, &mut out);
         }
-        self.step(s, Origin::Measured, &mut out);
         self.measure_released(out)
+    }
+
+    /// Feeds the interpolated samples of `hole`, the sample it held and `next`; with no
+    /// `next` (another hole, or the end) the hole is filled on the straight line to the
+    /// sample it held.
+    fn fill(&mut self, hole: PendingHole, next: Option<&RawSample>, out: &mut Released) {
+        let m = hole.missing;
+        let p0 = self.raw_line[slot(self.next.wrapping_sub(1))];
+        let pm1 = self.raw_line[slot(self.next.wrapping_sub(2))];
+        match (hole.after, next) {
+            (Some(q0), Some(q1)) => {
+                for k in 1..=m {
+                    let x = bridge::cubic(&[pm1, p0, q0, *q1], k, m);
+                    self.step(&x, hole.origin, out);
+                }
+                self.step(&q0, Origin::Measured, out);
+                self.step(q1, Origin::Measured, out);
+            }
+            (Some(q0), None) | (None, Some(&q0)) => {
+                for k in 1..=m {
+                    let x = bridge::linear(&p0, &q0, k, m + 1);
+                    self.step(&x, hole.origin, out);
+                }
+                self.step(&q0, Origin::Measured, out);
+            }
+            (None, None) => {}
+        }
     }
 
     /// The holes met so far, by what was done with them.
@@ -476,6 +514,13 @@ impl<const M: usize> Pipeline<M> {
         if missing == 0 {
             return None;
         }
+        // A bridged hole holding the sample after it is filled up to that sample now: the
+        // new hole follows it.
+        let mut flushed = Released::Nothing;
+        if self.hole.after.is_some() {
+            let hole = core::mem::take(&mut self.hole);
+            self.fill(hole, None, &mut flushed);
+        }
         let total = self.hole.missing.saturating_add(missing);
         if self.next > 0 && total <= self.fill_max {
             // Kept for the next sample to interpolate towards; counted as what it became.
@@ -484,19 +529,29 @@ impl<const M: usize> Pipeline<M> {
             self.hole = PendingHole {
                 missing: total,
                 origin: now,
+                after: None,
             };
             self.count(self.hole);
             if now == Origin::Filled && was != Origin::Filled {
                 // A movement with a long hole in it does not teach the foot frame.
                 self.frame.gap();
             }
-            return None;
+            return self.measure_released(flushed);
         }
         // Too long to interpolate (or nothing before it): a pending part joins it.
         self.uncount(self.hole);
         self.hole = PendingHole::default();
         self.holes.restarted = self.holes.restarted.saturating_add(1);
         self.holes.restarted_samples = self.holes.restarted_samples.saturating_add(total);
+        match (flushed, &mut self.segmenter) {
+            // A stride the flush released is held: the restart hands it out first.
+            (Released::Stride(s), Segmenter::Stance { tracker, .. }) => tracker.hold(s),
+            (Released::Step(s), _) => {
+                self.restart_after(total);
+                return Some(self.measure_step(s));
+            }
+            _ => {}
+        }
         self.restart_after(total)
     }
 
@@ -581,6 +636,17 @@ impl<const M: usize> Pipeline<M> {
     /// open). With [`Detector::PeakValley`] the first step still in flight; the others come
     /// from [`Pipeline::take`].
     pub fn finish(&mut self) -> [Option<Stride>; 2] {
+        let mut flushed = Released::Nothing;
+        if self.hole.after.is_some() {
+            // The sample held after a bridged hole is the last: fill up to it.
+            let hole = core::mem::take(&mut self.hole);
+            self.fill(hole, None, &mut flushed);
+        }
+        match (flushed, &mut self.segmenter) {
+            (Released::Stride(s), Segmenter::Stance { tracker, .. }) => tracker.hold(s),
+            (Released::Step(s), _) => return [Some(self.measure_step(s)), self.finish()[0]],
+            _ => {}
+        }
         if self.hole.missing > 0 {
             // A hole at the very end has no sample after it to interpolate towards: the
             // recording simply ended before it (counted as lost).
@@ -705,23 +771,6 @@ const fn origin_of(bridged: u128, filled: u128, at: u32) -> Origin {
         Origin::Filled
     } else {
         Origin::Measured
-    }
-}
-
-/// Sample `k` of the `n` periods from `a` (k = 0) to `b` (k = n), each axis on the straight
-/// line between them, rounded to the nearest count (halves up). Exact to rounding for
-/// `0 ≤ k ≤ n`: `|a·(n − k) + b·k| < 2¹⁵·n` fits an `i32` for any `n` < 2¹⁵.
-fn interpolate(a: &RawSample, b: &RawSample, k: u32, n: u32) -> RawSample {
-    let (k, n) = (k as i32, n as i32);
-    let at = |x: i16, y: i16| -> i16 {
-        let v = x as i32 * (n - k) + y as i32 * k;
-        (2 * v + n).div_euclid(2 * n) as i16
-    };
-    let axes = |x: [i16; 3], y: [i16; 3]| [at(x[0], y[0]), at(x[1], y[1]), at(x[2], y[2])];
-    RawSample {
-        accel: axes(a.accel, b.accel),
-        gyro: axes(a.gyro, b.gyro),
-        temp: at(a.temp, b.temp),
     }
 }
 

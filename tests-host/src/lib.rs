@@ -10,6 +10,7 @@ pub mod eval;
 pub mod firmware;
 pub mod fixtures;
 pub mod fuzzing;
+pub mod hole_sweep;
 
 pub mod length_eval;
 pub mod length_ref;

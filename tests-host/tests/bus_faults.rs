@@ -289,8 +289,10 @@ fn a_sensor_that_stops_mid_walk_is_restarted_and_its_stride_marked() {
     assert_eq!(bridged.len(), 1, "{strides:#?}");
     assert_eq!(bridged[0].start, mid.start);
     assert!(bridged[0].flags.valid(), "{:?}", bridged[0]);
+    // Its displacement is measured through the hole (the default model's length on the
+    // simulator's smooth feet moves more: they are outside what it was trained on).
     assert!(
-        bridged[0].length_mm.abs_diff(mid.length_mm) <= 10,
+        bridged[0].zupt_um.abs_diff(mid.zupt_um) <= 5_000,
         "{:?} vs {mid:?}",
         bridged[0]
     );

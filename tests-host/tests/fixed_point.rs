@@ -405,3 +405,86 @@ fn zupt_displacement_matches_f64_reference_within_1mm() {
     }
     assert!(checked >= 20);
 }
+
+fn raw(v: [i16; 7]) -> RawSample {
+    RawSample {
+        accel: [v[0], v[1], v[2]],
+        gyro: [v[3], v[4], v[5]],
+        temp: v[6],
+    }
+}
+
+fn axes(s: &RawSample) -> [i16; 7] {
+    [
+        s.accel[0], s.accel[1], s.accel[2], s.gyro[0], s.gyro[1], s.gyro[2], s.temp,
+    ]
+}
+
+/// `bridge::linear` is the straight line between its ends rounded to the nearest count
+/// (within ½ count of f64), for any samples and hole lengths up to the fill limit.
+#[test]
+fn bridge_line_is_the_rounded_straight_line() {
+    use gaitclip::bridge::linear;
+    let mut r = rng();
+    let mut worst = 0f64;
+    for _ in 0..20_000 {
+        let a: [i16; 7] = std::array::from_fn(|_| r.random());
+        let b: [i16; 7] = std::array::from_fn(|_| r.random());
+        let n = r.random_range(2..=151u32);
+        let k = r.random_range(1..n);
+        let got = axes(&linear(&raw(a), &raw(b), k, n));
+        for i in 0..7 {
+            let exact = a[i] as f64 + (b[i] as f64 - a[i] as f64) * k as f64 / n as f64;
+            worst = worst.max((got[i] as f64 - exact).abs());
+        }
+    }
+    eprintln!("linear: worst {worst} counts");
+    assert!(worst <= 0.5, "{worst}");
+}
+
+/// `bridge::cubic` is the Lagrange cubic through two samples either side of the hole,
+/// rounded to the nearest count and saturated: within ½ count of f64 wherever f64 is in
+/// range, the rail where it is not; and a cubic in time comes back to the count.
+#[test]
+fn bridge_cubic_is_the_rounded_lagrange_cubic() {
+    use gaitclip::bridge::cubic;
+    let mut r = rng();
+    let mut worst = 0f64;
+    for _ in 0..20_000 {
+        let p: [[i16; 7]; 4] = std::array::from_fn(|_| std::array::from_fn(|_| r.random()));
+        let m = r.random_range(1..=150u32);
+        let k = r.random_range(1..=m);
+        let got = axes(&cubic(&p.map(raw), k, m));
+        let xs = [-1.0, 0.0, m as f64 + 1.0, m as f64 + 2.0];
+        for i in 0..7 {
+            let x = k as f64;
+            let exact: f64 = (0..4)
+                .map(|j| {
+                    let w: f64 = (0..4)
+                        .filter(|&l| l != j)
+                        .map(|l| (x - xs[l]) / (xs[j] - xs[l]))
+                        .product();
+                    p[j][i] as f64 * w
+                })
+                .sum();
+            let clamped = exact.clamp(i16::MIN as f64, i16::MAX as f64);
+            worst = worst.max((got[i] as f64 - clamped).abs());
+        }
+    }
+    eprintln!("cubic: worst {worst} counts (f64 clamped to the rails)");
+    assert!(worst <= 0.5 + 1e-6, "{worst}");
+    // A cubic in time, sampled at -1, 0, m+1, m+2, is recovered at every sample of the hole.
+    let f = |t: f64| 100.0 + 30.0 * t - 2.0 * t * t + 0.05 * t * t * t;
+    for m in 1..=12u32 {
+        let at = |t: f64| raw([f(t).round() as i16; 7]);
+        let ends = [at(-1.0), at(0.0), at(m as f64 + 1.0), at(m as f64 + 2.0)];
+        for k in 1..=m {
+            let got = cubic(&ends, k, m).accel[0] as f64;
+            assert!(
+                (got - f(k as f64)).abs() <= 2.0,
+                "m {m} k {k}: {got} vs {}",
+                f(k as f64)
+            );
+        }
+    }
+}

@@ -99,6 +99,14 @@ enum Cmd {
         #[arg(long, default_value = "target/cost")]
         scratch: PathBuf,
     },
+    /// Cut holes of 1–16 samples into the walking strides of the datasets with per-stride
+    /// references and print what bridging them costs, by hole length (the README's hole
+    /// table, and the bridge limit it gives).
+    Holes {
+        /// The folder holding the datasets (`../shared/datasets`).
+        #[arg(default_value = "../../shared/datasets")]
+        datasets: PathBuf,
+    },
     /// Regenerate the simulated fixtures (traces with ground truth) into a folder.
     Simulate {
         /// Output folder.
@@ -376,6 +384,9 @@ fn run(cli: Cli) -> anyhow::Result<()> {
                 scratch: abs(scratch),
             })?;
             print!("{report}");
+        }
+        Cmd::Holes { datasets } => {
+            print!("{}", gaitclip_host::hole_sweep::report(&datasets)?);
         }
         Cmd::Simulate { out } => {
             fixtures::write_all(&out)?;
