@@ -24,7 +24,7 @@
 
 use crate::fixed::{div_round_i128, iroot_u128, root_q16};
 use crate::foot_frame::FOOT_LSB_PER_G;
-use crate::phase_stats::{Channel, ChannelStats, Segment, CHANNELS, SEGMENTS};
+use crate::phase_stats::{Channel, ChannelStats, Segment, StrideStats, CHANNELS, SEGMENTS};
 use crate::rate::SampleRate;
 use crate::stride::Stride;
 
@@ -153,11 +153,12 @@ impl Features {
         self.get(index(segment, channel, stat))
     }
 
-    /// The features of `stride`, recorded at `rate`.
-    pub fn of(stride: &Stride, rate: SampleRate) -> Features {
+    /// The features of `stride`, whose movement `stats` summarise
+    /// ([`crate::stride::StrideTracker::stats`]), recorded at `rate`.
+    pub fn of(stride: &Stride, stats: &StrideStats, rate: SampleRate) -> Features {
         let mut f = [0i64; COUNT];
         for seg in Segment::ALL {
-            let s = &stride.stats.segments[seg as usize];
+            let s = &stats.segments[seg as usize];
             for ch in Channel::ALL {
                 let v = channel_features(&s.channels[ch as usize], s.samples);
                 let at = index(seg, ch, Stat::Max);

@@ -128,6 +128,24 @@ pub struct StrideStats {
 }
 
 impl StrideStats {
+    /// No samples in any segment.
+    pub const EMPTY: StrideStats = {
+        let c = ChannelStats {
+            max: 0,
+            min: 0,
+            sum: 0,
+            sum_abs: 0,
+            sum_sq: 0,
+        };
+        let seg = SegmentStats {
+            samples: 0,
+            channels: [c; CHANNELS],
+        };
+        StrideStats {
+            segments: [seg; SEGMENTS],
+        }
+    };
+
     /// Summarises `movement` (`[vertical, sagittal, magnitude]` per sample) split at the
     /// offsets `toe_off` and `heel_strike` (clamped to the movement, in order).
     // Not inlined (nor are the splitter and the stride closing): each keeps its
@@ -137,7 +155,7 @@ impl StrideStats {
         let len = movement.len();
         let to = (toe_off as usize).min(len);
         let hs = (heel_strike as usize).clamp(to, len);
-        let mut out = StrideStats::default();
+        let mut out = StrideStats::EMPTY;
         for (i, x) in movement.iter().enumerate() {
             let phase = if i < to {
                 Segment::PushOff

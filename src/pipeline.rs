@@ -29,6 +29,7 @@ use crate::foot_frame::FootFrameEstimator;
 use crate::mean_filter::MeanFilter;
 use crate::models::{self, Model, ModelParams, Settings};
 use crate::peak_valley::{PeakValleyDetector, Step};
+use crate::phase_stats::StrideStats;
 use crate::phases::PhaseMethod;
 use crate::rate::SampleRate;
 use crate::rest::{RestDetector, RestThresholds};
@@ -192,6 +193,18 @@ impl HoleCounts {
     }
 }
 
+/// What [`Pipeline::gap`] does with a hole of a given length (on its own: holes declared
+/// one after the other add up).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum HoleKind {
+    /// Interpolated; the stride keeps its length ([`StrideFlags::BRIDGED`]).
+    Bridged,
+    /// Interpolated for the events; a stride whose movement it falls in is a gap stride.
+    Filled,
+    /// Detection restarts after it; the stride in progress is a gap stride.
+    Restart,
+}
+
 /// A hole waiting for the samples after it, to be interpolated across.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 struct PendingHole {
@@ -202,12 +215,18 @@ struct PendingHole {
     after: Option<RawSample>,
 }
 
-/// What one call's samples released, not yet measured.
-#[allow(clippy::large_enum_variant)] // one at a time, on the caller's frame
-enum Released {
-    Nothing,
-    Stride(Stride),
-    Step(Step),
+/// What one call's samples released, not yet measured: a stride of the stance detector's
+/// tracker (written into place by it, no copy on the way) or a peak-valley step.
+#[derive(Default)]
+struct Released {
+    stride: Option<Stride>,
+    step: Option<Step>,
+}
+
+impl Released {
+    fn is_empty(&self) -> bool {
+        self.stride.is_none() && self.step.is_none()
+    }
 }
 
 /// The step detector's state. A pipeline runs one detector for its life, so the two share
@@ -245,6 +264,8 @@ pub struct Pipeline<const M: usize = MAX_MOVEMENT_SAMPLES> {
     fill_max: u32,
     /// A hole to interpolate across at the next sample.
     hole: PendingHole,
+    /// A step released while filling a hole with no sample to report it from.
+    held_step: Option<Step>,
     holes: HoleCounts,
     /// Samples between an input and the raw sample the rest decision is about.
     rest_delay: u32,
@@ -314,6 +335,7 @@ impl<const M: usize> Pipeline<M> {
                 origin: Origin::Measured,
                 after: None,
             },
+            held_step: None,
             holes: HoleCounts {
                 bridged: 0,
                 bridged_samples: 0,
@@ -360,27 +382,60 @@ impl<const M: usize> Pipeline<M> {
     /// by the cubic through the two samples either side of it (this sample is then held
     /// until the next one arrives, one sample period late), a filled one on the straight
     /// line between the samples either side.
+    // Not inlined: the caller's frame (a board's main loop) then holds no stage's
+    // temporaries, and a hole's interpolation nests no deeper than a sample's stages.
+    #[inline(never)]
     pub fn process(&mut self, s: &RawSample) -> Option<Stride> {
-        let mut out = Released::Nothing;
+        let mut out = Released {
+            stride: None,
+            step: self.held_step.take(),
+        };
         if self.hole.missing > 0 {
-            if self.hole.origin == Origin::Bridged
-                && self.hole.after.is_none()
-                && self.since_reset >= 2
-            {
-                self.hole.after = Some(*s);
-                return None;
-            }
-            let hole = core::mem::take(&mut self.hole);
-            self.fill(hole, Some(s), &mut out);
+            self.after_hole(s, &mut out);
         } else {
             self.step(s, Origin::Measured, &mut out);
         }
         self.measure_released(out)
     }
 
+    /// [`Pipeline::process`] with a hole pending. Not inlined: the interpolation's
+    /// temporaries then take stack only after a hole, not on every sample's path (the M0's
+    /// stack has a few hundred bytes to spare).
+    #[inline(never)]
+    fn after_hole(&mut self, s: &RawSample, out: &mut Released) {
+        if self.hole.origin == Origin::Bridged && self.hole.after.is_none() && self.since_reset >= 2
+        {
+            self.hole.after = Some(*s);
+            return;
+        }
+        let hole = core::mem::take(&mut self.hole);
+        self.fill(hole, Some(s), out);
+    }
+
+    /// Fills a bridged hole up to the sample it holds, when no sample will follow it
+    /// (another hole, or the end). What that releases is held: a stride by the tracker,
+    /// reported at its next release, a step until the next sample. Not inlined, for the
+    /// stack (see [`Pipeline::after_hole`]).
+    #[inline(never)]
+    fn flush_held(&mut self) {
+        if self.hole.after.is_none() {
+            return;
+        }
+        let hole = core::mem::take(&mut self.hole);
+        let mut out = Released::default();
+        self.fill(hole, None, &mut out);
+        if let (Some(s), Segmenter::Stance { tracker, .. }) = (out.stride, &mut self.segmenter) {
+            tracker.hold(s);
+        }
+        if out.step.is_some() {
+            self.held_step = out.step;
+        }
+    }
+
     /// Feeds the interpolated samples of `hole`, the sample it held and `next`; with no
     /// `next` (another hole, or the end) the hole is filled on the straight line to the
     /// sample it held.
+    #[inline(never)]
     fn fill(&mut self, hole: PendingHole, next: Option<&RawSample>, out: &mut Released) {
         let m = hole.missing;
         let p0 = self.raw_line[slot(self.next.wrapping_sub(1))];
@@ -405,6 +460,17 @@ impl<const M: usize> Pipeline<M> {
         }
     }
 
+    /// The phase statistics of `stride` (the features' input), from its close until the
+    /// stride after the next one closes: for a host to compute every model's features for
+    /// the strides it is handed. `None` for the peak-valley detector's steps, for gap
+    /// strides, and once they are gone.
+    pub fn stats(&self, stride: &Stride) -> Option<&StrideStats> {
+        match &self.segmenter {
+            Segmenter::Stance { tracker, .. } => tracker.stats(stride.index),
+            Segmenter::PeakValley(_) => None,
+        }
+    }
+
     /// The holes met so far, by what was done with them.
     pub const fn holes(&self) -> HoleCounts {
         self.holes
@@ -413,7 +479,7 @@ impl<const M: usize> Pipeline<M> {
     /// One sample through the stages; what it releases goes into `out` (at most one thing
     /// per call of [`Pipeline::process`], see [`FILL_MAX_MS`]; a second stride would be
     /// held back by the tracker, a second step by the peak-valley detector).
-    #[inline(always)]
+    #[inline(never)]
     fn step(&mut self, s: &RawSample, origin: Origin, out: &mut Released) {
         let index = self.next;
         self.next = self.next.wrapping_add(1);
@@ -443,13 +509,10 @@ impl<const M: usize> Pipeline<M> {
             Segmenter::PeakValley(peaks) => {
                 // The filtered value is the mean of a window centred `delay` samples back.
                 let at = index.wrapping_sub(self.filter.delay());
-                match out {
-                    Released::Nothing => {
-                        if let Some(step) = peaks.process(at, foot[2]) {
-                            *out = Released::Step(step);
-                        }
-                    }
-                    _ => peaks.feed(at, foot[2]),
+                if out.is_empty() {
+                    out.step = peaks.process(at, foot[2]);
+                } else {
+                    peaks.feed(at, foot[2]);
                 }
                 return;
             }
@@ -467,21 +530,16 @@ impl<const M: usize> Pipeline<M> {
         let foot_at = index.wrapping_sub(stance.delay());
         let (raw, foot) = (self.raw_line[slot(at)], self.foot_line[slot(foot_at)]);
         let origin = origin_of(self.bridged_line, self.filled_line, at);
-        if let Some(stride) = tracker.process(at, &raw, foot, decision, origin) {
-            match out {
-                Released::Nothing => *out = Released::Stride(stride),
-                _ => tracker.hold(stride),
-            }
-        }
+        tracker.process_into(at, &raw, foot, decision, origin, &mut out.stride);
     }
 
     /// Measures what a call released.
-    fn measure_released(&self, out: Released) -> Option<Stride> {
-        match out {
-            Released::Nothing => None,
-            Released::Stride(s) => Some(self.measure(s)),
-            Released::Step(s) => Some(self.measure_step(s)),
+    fn measure_released(&self, mut out: Released) -> Option<Stride> {
+        if let Some(s) = out.stride.as_mut() {
+            self.measure(s);
+            return out.stride;
         }
+        out.step.map(|s| self.measure_step(s))
     }
 
     /// Declares `missing` samples lost (FIFO overflow, a sensor that stopped answering, a
@@ -516,11 +574,7 @@ impl<const M: usize> Pipeline<M> {
         }
         // A bridged hole holding the sample after it is filled up to that sample now: the
         // new hole follows it.
-        let mut flushed = Released::Nothing;
-        if self.hole.after.is_some() {
-            let hole = core::mem::take(&mut self.hole);
-            self.fill(hole, None, &mut flushed);
-        }
+        self.flush_held();
         let total = self.hole.missing.saturating_add(missing);
         if self.next > 0 && total <= self.fill_max {
             // Kept for the next sample to interpolate towards; counted as what it became.
@@ -536,23 +590,29 @@ impl<const M: usize> Pipeline<M> {
                 // A movement with a long hole in it does not teach the foot frame.
                 self.frame.gap();
             }
-            return self.measure_released(flushed);
+            return None;
         }
         // Too long to interpolate (or nothing before it): a pending part joins it.
         self.uncount(self.hole);
         self.hole = PendingHole::default();
         self.holes.restarted = self.holes.restarted.saturating_add(1);
         self.holes.restarted_samples = self.holes.restarted_samples.saturating_add(total);
-        match (flushed, &mut self.segmenter) {
-            // A stride the flush released is held: the restart hands it out first.
-            (Released::Stride(s), Segmenter::Stance { tracker, .. }) => tracker.hold(s),
-            (Released::Step(s), _) => {
-                self.restart_after(total);
-                return Some(self.measure_step(s));
-            }
-            _ => {}
+        if let Some(s) = self.held_step.take() {
+            self.restart_after(total);
+            return Some(self.measure_step(s));
         }
         self.restart_after(total)
+    }
+
+    /// What a hole of `missing` samples, on its own, becomes.
+    pub const fn hole_kind(&self, missing: u32) -> HoleKind {
+        if missing <= self.bridge_max {
+            HoleKind::Bridged
+        } else if missing <= self.fill_max {
+            HoleKind::Filled
+        } else {
+            HoleKind::Restart
+        }
     }
 
     fn origin_for(&self, missing: u32) -> Origin {
@@ -627,7 +687,7 @@ impl<const M: usize> Pipeline<M> {
         self.frame.gap();
         // Measured last and once: a single stride on this frame while the models run keeps
         // the gap path's stack no deeper than a sample's.
-        out.map(|s| self.measure(s))
+        out.map(|s| self.measured(s))
     }
 
     /// Drains the samples still in the delay line at the end of a recording, with the last
@@ -636,17 +696,9 @@ impl<const M: usize> Pipeline<M> {
     /// open). With [`Detector::PeakValley`] the first step still in flight; the others come
     /// from [`Pipeline::take`].
     pub fn finish(&mut self) -> [Option<Stride>; 2] {
-        let mut flushed = Released::Nothing;
-        if self.hole.after.is_some() {
-            // The sample held after a bridged hole is the last: fill up to it.
-            let hole = core::mem::take(&mut self.hole);
-            self.fill(hole, None, &mut flushed);
-        }
-        match (flushed, &mut self.segmenter) {
-            (Released::Stride(s), Segmenter::Stance { tracker, .. }) => tracker.hold(s),
-            (Released::Step(s), _) => return [Some(self.measure_step(s)), self.finish()[0]],
-            _ => {}
-        }
+        // The sample held after a bridged hole is the last: fill up to it.
+        self.flush_held();
+        let flushed_step = self.held_step.take();
         if self.hole.missing > 0 {
             // A hole at the very end has no sample after it to interpolate towards: the
             // recording simply ended before it (counted as lost).
@@ -658,13 +710,16 @@ impl<const M: usize> Pipeline<M> {
         }
         let drained = self.drain();
         let Segmenter::Stance { tracker, .. } = &mut self.segmenter else {
-            return [self.take(), None];
+            return match flushed_step {
+                Some(s) => [Some(self.measure_step(s)), self.take()],
+                None => [self.take(), None],
+            };
         };
         let first = drained.or_else(|| tracker.finish());
         let second = tracker.finish();
         let out = [
-            first.map(|s| self.measure(s)),
-            second.map(|s| self.measure(s)),
+            first.map(|s| self.measured(s)),
+            second.map(|s| self.measured(s)),
         ];
         self.since_reset = 0;
         self.stance_fed = 0;
@@ -742,16 +797,23 @@ impl<const M: usize> Pipeline<M> {
     // Not inlined: the per-stride work stays out of the per-sample frame (stack), and
     // `gaitclip cost` counts it apart from the sample path.
     #[inline(never)]
-    fn measure(&self, mut s: Stride) -> Stride {
+    fn measure(&self, s: &mut Stride) {
         if s.flags.has(StrideFlags::GAP) {
             // No length across a gap; `length_mm` stays 0.
-            return s;
+            return;
         }
-        let f = Features::of(&s, self.rate);
+        // The ZUPT model, the fallback, needs no statistics: empty ones if they were gone.
+        let stats = self.stats(s).unwrap_or(&StrideStats::EMPTY);
+        let f = Features::of(s, stats, self.rate);
         let mm = models::predict_mm(self.model, &f, self.settings, self.params)
             .or_else(|| models::predict_mm(Model::Zupt, &f, self.settings, self.params))
             .unwrap_or(0);
-        set_length(&mut s, mm);
+        set_length(s, mm);
+    }
+
+    /// [`Pipeline::measure`] on a stride that is handed back.
+    fn measured(&self, mut s: Stride) -> Stride {
+        self.measure(&mut s);
         s
     }
 }

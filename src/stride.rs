@@ -9,9 +9,11 @@
 //!
 //! Heel-off and foot-flat are the edges of the stances ([`crate::stance`]); toe-off and
 //! heel-strike come from Huang's splitter ([`crate::phases`]) run on the movement's
-//! foot-frame acceleration. A stride carries what the length models need: the ZUPT
-//! displacement of the movement ([`crate::zupt`]) and integer summaries of its acceleration
-//! phase by phase ([`crate::phase_stats`]); the pipeline fills in the length.
+//! foot-frame acceleration. A stride carries the ZUPT displacement of the movement
+//! ([`crate::zupt`]); the integer summaries of its acceleration phase by phase
+//! ([`crate::phase_stats`]), which the length models' features need, stay with the tracker
+//! ([`StrideTracker::stats`]: ten times the record's size, they need not travel with it);
+//! the pipeline fills in the length.
 //!
 //! **What is and is not a stride.** A movement shorter than [`MIN_MOVEMENT_MS`] is a wobble
 //! of a foot on the ground and merges into the stance; standing still therefore yields no
@@ -128,8 +130,6 @@ pub struct Stride {
     pub climb_mm: i32,
     /// Qualifiers.
     pub flags: StrideFlags,
-    /// The movement's acceleration summarised phase by phase, for the features.
-    pub stats: StrideStats,
 }
 
 /// Where a sample fed to the tracker comes from: the sensor, or the pipeline's
@@ -189,6 +189,11 @@ pub struct StrideTracker<const M: usize = MAX_MOVEMENT_SAMPLES> {
     moving_after_gap: u32,
     /// Number of the last sample fed, plus one.
     fed_end: u32,
+    /// Strides neither reported nor held ([`StrideTracker::dropped`]).
+    dropped: u32,
+    /// The phase statistics of the last two strides closed, by stride index parity, with
+    /// the index they belong to: a stride's stay until the one after the next is closed.
+    stats: [(u32, StrideStats); 2],
 }
 
 impl StrideTracker {
@@ -222,6 +227,11 @@ impl<const M: usize> StrideTracker<M> {
             gap_in_movement: false,
             moving_after_gap: 0,
             fed_end: 0,
+            dropped: 0,
+            stats: [
+                (u32::MAX, StrideStats::EMPTY),
+                (u32::MAX, StrideStats::EMPTY),
+            ],
         }
     }
 
@@ -339,12 +349,69 @@ impl<const M: usize> StrideTracker<M> {
         stance: bool,
         origin: Origin,
     ) -> Option<Stride> {
+        let mut out = None;
+        self.process_into(index, s, foot, stance, origin, &mut out);
+        out
+    }
+
+    /// [`StrideTracker::process`], the stride it lets the tracker report put into `out`
+    /// (no copy of it on this frame; the pipeline feeds several samples per call after a
+    /// hole, and the M0's stack is short). A stride released while `out` is taken is held
+    /// back and released at the next chance (by construction it cannot happen: two
+    /// releases are a movement apart).
+    pub fn process_into(
+        &mut self,
+        index: u32,
+        s: &RawSample,
+        foot: [i16; 3],
+        stance: bool,
+        origin: Origin,
+        out: &mut Option<Stride>,
+    ) {
         self.fed_end = index.wrapping_add(1);
-        let out = self.transition(index, s, foot, stance);
+        self.transition(index, s, foot, stance, out);
         if origin != Origin::Measured {
             self.mark(index, origin);
         }
-        out
+    }
+
+    /// The phase statistics of stride number `index`, while they are kept: from its close
+    /// until the stride after the next one closes (a stride is measured as it is released,
+    /// long before). `None` for a stride whose statistics are gone, and for a gap stride.
+    pub fn stats(&self, index: u32) -> Option<&StrideStats> {
+        let (at, stats) = &self.stats[(index & 1) as usize];
+        (*at == index).then_some(stats)
+    }
+
+    /// Strides the tracker could neither report nor hold (three at once): none by
+    /// construction, counted so that a test would see one.
+    pub const fn dropped(&self) -> u32 {
+        self.dropped
+    }
+
+    /// Hands the held stride out into `out`, if there is one and `out` is free.
+    fn release(&mut self, out: &mut Option<Stride>, to_rest: bool) {
+        if out.is_none() {
+            *out = self.pending.take();
+            if to_rest {
+                if let Some(st) = out {
+                    st.flags.0 |= StrideFlags::TO_REST;
+                }
+            }
+        }
+    }
+
+    /// Holds `stride` as the one waiting for the stance after it; one still held is
+    /// handed out first (it cannot be: a stance always precedes a movement).
+    fn hold_new(&mut self, stride: Stride, out: &mut Option<Stride>) {
+        if self.pending.is_some() {
+            self.release(out, false);
+        }
+        if self.pending.is_none() {
+            self.pending = Some(stride);
+        } else {
+            self.dropped = self.dropped.saturating_add(1);
+        }
     }
 
     /// Notes an interpolated sample in the stance or movement it now belongs to.
@@ -368,11 +435,11 @@ impl<const M: usize> StrideTracker<M> {
         s: &RawSample,
         foot: [i16; 3],
         stance: bool,
-    ) -> Option<Stride> {
+        out: &mut Option<Stride>,
+    ) {
         match (self.state, stance) {
             (State::Gap, false) => {
                 self.moving_after_gap = self.moving_after_gap.saturating_add(1);
-                None
             }
             (State::Gap, true) => {
                 let stride = self.gap_stride_happened().then(|| self.close_gap(index));
@@ -381,25 +448,22 @@ impl<const M: usize> StrideTracker<M> {
                 self.clear_stance();
                 self.accumulate_stance(s);
                 // Nothing is held in a gap ([`Self::gap`] handed it out), but never lose one.
-                stride.and_then(|st| self.pending.replace(st))
+                if let Some(st) = stride {
+                    self.hold_new(st, out);
+                }
             }
-            (State::Unprimed, false) => None,
+            (State::Unprimed, false) => {}
             (State::Unprimed, true) => {
                 self.state = State::Stance;
                 self.stance_start = index;
                 self.clear_stance();
                 self.accumulate_stance(s);
-                None
             }
             (State::Stance, true) => {
                 self.accumulate_stance(s);
                 if index.wrapping_sub(self.stance_start) > self.max_stance {
-                    return self.pending.take().map(|mut st| {
-                        st.flags.0 |= StrideFlags::TO_REST;
-                        st
-                    });
+                    self.release(out, true);
                 }
-                None
             }
             (State::Stance, false) => {
                 if self.zupt.start(&self.stance_sums) {
@@ -409,13 +473,11 @@ impl<const M: usize> StrideTracker<M> {
                     self.flags = 0;
                     self.filled = None;
                     self.accumulate_movement(s, foot);
-                    return self.pending.take();
+                    self.release(out, false);
                 }
-                None
             }
             (State::Moving, false) => {
                 self.accumulate_movement(s, foot);
-                None
             }
             (State::Moving, true) => {
                 let moved = index.wrapping_sub(self.heel_off);
@@ -427,15 +489,17 @@ impl<const M: usize> StrideTracker<M> {
                         self.stance_bridged_at = Some(index.wrapping_sub(1));
                     }
                     self.accumulate_stance(s);
-                    return None;
+                    return;
                 }
-                let stride = self.close(index);
+                // A stride still held here had no stance after it long enough to end it:
+                // cannot happen (a stance always precedes a movement), but never lose one.
+                if self.pending.is_some() {
+                    self.release(out, false);
+                }
+                self.close(index);
                 self.stance_start = index;
                 self.clear_stance();
                 self.accumulate_stance(s);
-                // A stride still held here had no stance after it long enough to end it:
-                // cannot happen (a stance always precedes a movement), but never lose one.
-                self.pending.replace(stride)
             }
         }
     }
@@ -458,8 +522,10 @@ impl<const M: usize> StrideTracker<M> {
         }
     }
 
-    #[inline(never)] // see StrideStats::measure
-    fn close(&mut self, foot_flat: u32) -> Stride {
+    /// Closes the movement at `foot_flat` into the held stride (which is free). Not
+    /// inlined: see [`StrideStats::measure`].
+    #[inline(never)]
+    fn close(&mut self, foot_flat: u32) {
         let split = phases::split(&self.movement, self.phase_method, self.merge_samples);
         let mut flags = self.flags;
         if !split.found {
@@ -489,10 +555,12 @@ impl<const M: usize> StrideTracker<M> {
             }
         }
         let d = self.zupt.displacement();
-        let stats = StrideStats::measure(&self.movement, split.toe_off, split.heel_strike);
         let index = self.next_index;
         self.next_index = self.next_index.wrapping_add(1);
-        Stride {
+        let slot = &mut self.stats[(index & 1) as usize];
+        slot.0 = index;
+        slot.1 = StrideStats::measure(&self.movement, split.toe_off, split.heel_strike);
+        let held = Stride {
             index,
             start,
             heel_off: self.heel_off,
@@ -504,7 +572,11 @@ impl<const M: usize> StrideTracker<M> {
             climb_mm: ((d.vertical_um + 500).div_euclid(1000))
                 .clamp(i32::MIN as i64, i32::MAX as i64) as i32,
             flags: StrideFlags(flags),
-            stats,
+        };
+        if self.pending.is_none() {
+            self.pending = Some(held);
+        } else {
+            self.dropped = self.dropped.saturating_add(1);
         }
     }
 }

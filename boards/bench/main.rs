@@ -30,6 +30,7 @@ use cortex_m_semihosting::debug;
 use defmt_semihosting as _;
 use gaitclip::features::Features;
 use gaitclip::models::{self, Model, Settings};
+use gaitclip::phase_stats::StrideStats;
 use gaitclip::pipeline::{Config, Detector, Pipeline};
 use gaitclip::rate::SampleRate;
 use gaitclip::sample::{AccelRange, GyroRange, RawSample, SAMPLE_BYTES};
@@ -80,7 +81,7 @@ fn main() -> ! {
         samples += 1;
         if let Ok(motion) = <&[u8; trace::MOTION_BYTES]>::try_from(block) {
             if let Some(s) = bench_sample(pipeline, &registers(motion)) {
-                on_stride(&mut totals, &s);
+                on_stride(&mut totals, pipeline, &s);
             }
         }
     }
@@ -108,14 +109,18 @@ fn main() -> ! {
 // Not inlined, nor is `drain`: their strides and features (≈ 1.3 KiB) would otherwise sit in
 // `main`'s frame under the whole sample path, and the M0's stack is ≈ 8 KiB.
 #[inline(never)]
-fn on_stride(totals: &mut Totals, s: &Stride) {
+fn on_stride(totals: &mut Totals, pipeline: &Pipeline<MOVEMENT_SAMPLES>, s: &Stride) {
     totals.strides += 1;
     totals.distance_mm += u64::from(s.length_mm);
     if CONFIG.detector == Detector::PeakValley {
         // Lu's chain measured the step inside the pipeline; no features, no models.
         return;
     }
-    let f = bench_features(s);
+    let Some(stats) = pipeline.stats(s) else {
+        // A gap stride: no length, no features.
+        return;
+    };
+    let f = bench_features(s, stats);
     for model in Model::ALL {
         if CONFIG.params.ships(model) {
             bench_model(model, &f);
@@ -127,10 +132,10 @@ fn on_stride(totals: &mut Totals, s: &Stride) {
 #[inline(never)]
 fn drain(pipeline: &mut Pipeline<MOVEMENT_SAMPLES>, totals: &mut Totals) {
     for s in pipeline.finish().iter().flatten() {
-        on_stride(totals, s);
+        on_stride(totals, pipeline, s);
     }
     while let Some(s) = pipeline.take() {
-        on_stride(totals, &s);
+        on_stride(totals, pipeline, &s);
     }
 }
 
@@ -162,8 +167,8 @@ fn bench_sample(
 
 /// The features of one stride.
 #[inline(never)]
-fn bench_features(s: &Stride) -> Features {
-    black_box(Features::of(s, RATE))
+fn bench_features(s: &Stride, stats: &StrideStats) -> Features {
+    black_box(Features::of(s, stats, RATE))
 }
 
 /// One model's length of one stride.

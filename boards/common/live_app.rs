@@ -225,7 +225,7 @@ pub fn main_loop<const M: usize>(
                     log.summary(samples, &counters(), serial);
                 }
                 Item::Sample(_) => {}
-                Item::Gap(n) => log.gap(n, serial),
+                Item::Gap(n) => log.gap(n, pipeline.hole_kind(n), serial),
             }
         }
         // Interrupts are masked while checking the queue so that a sample arriving between

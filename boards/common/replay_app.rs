@@ -29,6 +29,14 @@ use crate::trace;
 /// Samples the queue holds between the interrupt and the main loop: 32 = 160 ms at 200 Hz,
 /// more than one stride's processing takes on either core.
 pub const QUEUE_LEN: usize = 32;
+/// Runs of samples the emulated sensor loses, `(first sample, samples)`: none, or with the
+/// `replay-holes` feature the runs of [`crate::replay_holes::LOST`], so that a QEMU run can
+/// be compared with the host replay of the same holes (`firmware_qemu`).
+#[cfg(not(feature = "replay-holes"))]
+pub const LOST: &[(u32, u32)] = &[];
+#[cfg(feature = "replay-holes")]
+pub use crate::replay_holes::LOST;
+
 /// Samples in the stored trace: the number of data-ready pulses the timer gives.
 pub const TRACE_SAMPLES: u32 = (trace::REGISTERS.len() / SAMPLE_BYTES) as u32;
 
@@ -102,7 +110,7 @@ pub fn run<const M: usize>(
     unmask: impl FnOnce(),
 ) -> ! {
     let imu = Mpu6050::new(
-        ReplayMpu6050::new(Address::Ad0Low.bits(), trace::REGISTERS),
+        ReplayMpu6050::new(Address::Ad0Low.bits(), trace::REGISTERS, LOST),
         Address::Ad0Low,
     );
     let sampler = match ImuSampler::start(
@@ -182,7 +190,7 @@ fn handle<const M: usize>(
         log.stride(stride, serial);
     }
     if let Item::Gap(n) = item {
-        log.gap(n, serial);
+        log.gap(n, pipeline.hole_kind(n), serial);
     }
 }
 

@@ -7,6 +7,12 @@
 //! `GYRO_ZOUT_L` latches the next sample, as a new conversion would. The real driver runs
 //! unchanged on top of it, so everything after the bus read is the code real hardware runs.
 //!
+//! It can also lose samples, as a sensor whose reads fail for a few periods does (a bus
+//! glitch, a brown-out): every read of the data registers that would start a lost run fails,
+//! as many times as the sampler tries in those periods, and the run's samples are skipped.
+//! The replay firmware uses it to show that the pipeline bridges such holes on the board as
+//! the host replay does.
+//!
 //! Board glue, not core: it is safe code but knows a storage format.
 
 use embedded_hal::i2c::{self, ErrorKind, NoAcknowledgeSource, Operation, SevenBitAddress};
@@ -25,6 +31,8 @@ pub enum ReplayBusError {
     NoDevice,
     /// The trace has no samples left: the recording is over.
     Exhausted,
+    /// The sample of this period is lost (the read is not acknowledged).
+    Lost,
 }
 
 impl i2c::Error for ReplayBusError {
@@ -32,9 +40,13 @@ impl i2c::Error for ReplayBusError {
         match self {
             ReplayBusError::NoDevice => ErrorKind::NoAcknowledge(NoAcknowledgeSource::Address),
             ReplayBusError::Exhausted => ErrorKind::Other,
+            ReplayBusError::Lost => ErrorKind::NoAcknowledge(NoAcknowledgeSource::Data),
         }
     }
 }
+
+/// Failed read attempts per lost sample period: the sampler's first try and its retries.
+const ATTEMPTS_PER_PERIOD: u32 = crate::imu_sampler::RETRIES + 1;
 
 /// The emulated sensor.
 pub struct ReplayMpu6050 {
@@ -44,12 +56,19 @@ pub struct ReplayMpu6050 {
     cursor: usize,
     regs: [u8; 128],
     pointer: u8,
+    /// Runs of samples lost, `(first sample, samples)`, in order.
+    lost: &'static [(u32, u32)],
+    /// The next run of `lost` not yet reached.
+    next_lost: usize,
+    /// Read attempts still to fail in the run being lost, and its samples.
+    failing: (u32, u32),
 }
 
 impl ReplayMpu6050 {
     /// A sensor at `address` (0x68 or 0x69) replaying `trace` (a whole number of 14-byte
-    /// register blocks; a trailing partial block is ignored).
-    pub const fn new(address: u8, trace: &'static [u8]) -> Self {
+    /// register blocks; a trailing partial block is ignored) and losing the runs of samples
+    /// `lost` (`(first sample, samples)`, sorted, not overlapping).
+    pub const fn new(address: u8, trace: &'static [u8], lost: &'static [(u32, u32)]) -> Self {
         let mut regs = [0u8; 128];
         regs[WHO_AM_I as usize] = 0x68;
         ReplayMpu6050 {
@@ -58,7 +77,31 @@ impl ReplayMpu6050 {
             cursor: 0,
             regs,
             pointer: 0,
+            lost,
+            next_lost: 0,
+            failing: (0, 0),
         }
+    }
+
+    /// Whether this read of the data registers fails because its sample is lost; the lost
+    /// samples are skipped once every attempt for them has failed.
+    fn loses_this_read(&mut self) -> bool {
+        if self.failing.0 == 0 {
+            let sample = (self.cursor / SAMPLE_BYTES) as u32;
+            match self.lost.get(self.next_lost) {
+                Some(&(first, n)) if first == sample && n > 0 => {
+                    self.next_lost += 1;
+                    self.failing = (n * ATTEMPTS_PER_PERIOD, n);
+                }
+                _ => return false,
+            }
+        }
+        self.failing.0 -= 1;
+        if self.failing.0 == 0 {
+            self.cursor =
+                (self.cursor + self.failing.1 as usize * SAMPLE_BYTES).min(self.trace.len());
+        }
+        true
     }
 
     /// Samples not yet read.
@@ -114,6 +157,9 @@ impl i2c::I2c<SevenBitAddress> for ReplayMpu6050 {
                     }
                 }
                 Operation::Read(buf) => {
+                    if self.pointer == DATA_FIRST && self.loses_this_read() {
+                        return Err(ReplayBusError::Lost);
+                    }
                     for b in buf.iter_mut() {
                         *b = self.read_byte()?;
                     }

@@ -10,14 +10,14 @@
 //! # hold still: waiting for the clip to rest (2 s)
 //! # still: gyro_bias_mdps=-1220,305,61 gravity_mg=1003
 //! 0,5120,1362,1105,420,150,380,155,3,4,1
-//! # gap samples=12: the stride in progress is reported invalid (flag 64), without a length
+//! # hole samples=12 filled: a stride whose movement it falls in is a gap stride (flag 64), without a length
 //! # status samples=24000 strides=96 distance_mm=131012 bus_errors=0 restarts=0 fifo_overflows=0 silences=0 overruns=0 lost_samples=0
 //! ```
 //!
 //! `index` counts strides from 0; `t_ms` is the start of the stride since power-up;
 //! `duration_ms` is the whole stride and the four phase columns add up to it; `flags` is
 //! the bit set of [`gaitclip::stride::StrideFlags`] (1 saturated, 2 too long, 4 from rest,
-//! 8 to rest, 16 turn, 32 phases guessed, 64 gap, 128 implausible); `valid` is 0 when a flag
+//! 8 to rest, 16 turn, 32 phases guessed, 64 gap, 128 implausible, 256 bridged); `valid` is 0 when a flag
 //! makes the length untrustworthy (a gap stride has length 0).
 //! `tests-host/tests/board_glue.rs` parses these lines back.
 

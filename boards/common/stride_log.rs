@@ -7,7 +7,7 @@
 
 use core::fmt::Write;
 
-use gaitclip::pipeline::Config;
+use gaitclip::pipeline::{Config, HoleKind};
 use gaitclip::rate::SampleRate;
 use gaitclip::stride::Stride;
 
@@ -136,18 +136,18 @@ impl StrideLog {
     }
 
     /// Reports a gap in the samples.
-    pub fn gap(&self, samples: u32, serial: &mut impl Write) {
-        defmt::warn!(
-            "gap of {=u32} samples: the stride in progress is reported invalid, without a length",
-            samples
-        );
-        let _ = serial_line::comment(
-            serial,
-            format_args!(
-                "gap samples={}: the stride in progress is reported invalid, without a length",
-                samples
-            ),
-        );
+    pub fn gap(&self, samples: u32, kind: HoleKind, serial: &mut impl Write) {
+        let what = match kind {
+            HoleKind::Bridged => "bridged: the stride keeps its length (flag 256)",
+            HoleKind::Filled => {
+                "filled: a stride whose movement it falls in is a gap stride (flag 64), without a length"
+            }
+            HoleKind::Restart => {
+                "detection restarts: the stride in progress is a gap stride (flag 64), without a length"
+            }
+        };
+        defmt::warn!("hole of {=u32} samples {=str}", samples, what);
+        let _ = serial_line::comment(serial, format_args!("hole samples={} {}", samples, what));
     }
 
     /// Logs the status (periodically, and at the end of a run).

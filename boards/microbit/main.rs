@@ -18,6 +18,9 @@ mod imu_sampler;
 mod live_app;
 #[path = "../common/replay_app.rs"]
 mod replay_app;
+#[cfg(feature = "replay-holes")]
+#[path = "../common/replay_holes.rs"]
+mod replay_holes;
 #[path = "../common/replay_mpu6050.rs"]
 mod replay_mpu6050;
 #[allow(dead_code)]

@@ -7,16 +7,17 @@ use gaitclip::features::{self, Stat, COUNT, STATS, STRIDE_FREQUENCY, ZUPT_LENGTH
 use gaitclip::foot_frame::FOOT_LSB_PER_G;
 use gaitclip::fuzzy::RULES;
 use gaitclip::models::{Model, Settings, MAX_TERMS};
-use gaitclip::phase_stats::{Channel, ChannelStats, Segment};
+use gaitclip::phase_stats::{Channel, ChannelStats, Segment, StrideStats};
 use gaitclip::rate::SampleRate;
 use gaitclip::stride::Stride;
 
-/// The features of a stride in f64, in the units of [`gaitclip::features`] (not Q16).
-pub fn features(stride: &Stride, rate: SampleRate) -> [f64; COUNT] {
+/// The features of a stride in f64, in the units of [`gaitclip::features`] (not Q16), from
+/// its phase statistics `stats`.
+pub fn features(stride: &Stride, stats: &StrideStats, rate: SampleRate) -> [f64; COUNT] {
     let hz = rate.millihertz() as f64 / 1000.0;
     let mut f = [0.0; COUNT];
     for seg in Segment::ALL {
-        let s = &stride.stats.segments[seg as usize];
+        let s = &stats.segments[seg as usize];
         for ch in Channel::ALL {
             let v = channel(&s.channels[ch as usize], s.samples);
             let at = features::index(seg, ch, Stat::Max);

@@ -5,6 +5,7 @@ use std::collections::BTreeMap;
 
 use gaitclip::features::Features;
 use gaitclip::models::{self, Model};
+use gaitclip::phase_stats::StrideStats;
 use gaitclip::pipeline::{Config, Detector, HoleCounts, Pipeline};
 use gaitclip::rate::SampleRate;
 use gaitclip::sample::RawSample;
@@ -152,6 +153,9 @@ pub struct StrideReport {
     /// The core's integer record, as the firmware logs it.
     #[serde(skip)]
     pub raw: Stride,
+    /// Its phase statistics (the features' input).
+    #[serde(skip)]
+    pub stats: StrideStats,
 }
 
 /// Names of the stride flags, in bit order.
@@ -212,18 +216,36 @@ pub fn core_strides_gapped(samples: &[RawSample], gaps: &[Gap], config: Config) 
 
 /// [`core_strides_gapped`], and what the core did with the holes.
 pub fn core_run(samples: &[RawSample], gaps: &[Gap], config: Config) -> (Vec<Stride>, HoleCounts) {
+    let (strides, holes) = core_run_with_stats(samples, gaps, config);
+    (strides.into_iter().map(|(s, _)| s).collect(), holes)
+}
+
+/// [`core_run`], each stride with its phase statistics (the features' input; empty for a
+/// gap stride or a peak-valley step), taken from the pipeline as it hands the stride out.
+pub fn core_run_with_stats(
+    samples: &[RawSample],
+    gaps: &[Gap],
+    config: Config,
+) -> (Vec<(Stride, StrideStats)>, HoleCounts) {
     let mut p = Pipeline::new(config);
     let mut strides = Vec::new();
+    let with_stats = |p: &Pipeline, s: Stride| (s, p.stats(&s).copied().unwrap_or_default());
     let mut next_gap = gaps.iter().peekable();
     for (i, s) in samples.iter().enumerate() {
         while let Some(g) = next_gap.next_if(|g| g.before <= i) {
-            strides.extend(p.gap(g.missing));
+            if let Some(st) = p.gap(g.missing) {
+                strides.push(with_stats(&p, st));
+            }
         }
-        strides.extend(p.process(s));
+        if let Some(st) = p.process(s) {
+            strides.push(with_stats(&p, st));
+        }
     }
-    strides.extend(p.finish().into_iter().flatten());
-    while let Some(s) = p.take() {
-        strides.push(s);
+    for st in p.finish().into_iter().flatten() {
+        strides.push(with_stats(&p, st));
+    }
+    while let Some(st) = p.take() {
+        strides.push(with_stats(&p, st));
     }
     (strides, p.holes())
 }
@@ -249,9 +271,14 @@ impl Prepared {
         core_strides_gapped(&self.counts, &self.clock.holes, config)
     }
 
-    /// [`Prepared::strides`] and the summary of what was done to the samples.
-    pub fn run(&self, config: Config) -> (Vec<Stride>, Summary) {
-        let (strides, h) = core_run(&self.counts, &self.clock.holes, config);
+    /// [`Prepared::strides`] with their phase statistics.
+    pub fn strides_with_stats(&self, config: Config) -> Vec<(Stride, StrideStats)> {
+        core_run_with_stats(&self.counts, &self.clock.holes, config).0
+    }
+
+    /// [`Prepared::strides_with_stats`] and the summary of what was done to the samples.
+    pub fn run(&self, config: Config) -> (Vec<(Stride, StrideStats)>, Summary) {
+        let (strides, h) = core_run_with_stats(&self.counts, &self.clock.holes, config);
         let summary = Summary {
             samples_read: self.read.0,
             repeated_dropped: self.read.1,
@@ -263,19 +290,19 @@ impl Prepared {
             gap_samples: h.gap_samples(),
             gaps_filled: h.filled,
             strides: strides.len(),
-            valid_strides: strides.iter().filter(|s| s.flags.valid()).count(),
+            valid_strides: strides.iter().filter(|s| s.0.flags.valid()).count(),
             bridged_strides: strides
                 .iter()
-                .filter(|s| s.flags.has(StrideFlags::BRIDGED))
+                .filter(|s| s.0.flags.has(StrideFlags::BRIDGED))
                 .count(),
             gap_strides: strides
                 .iter()
-                .filter(|s| s.flags.has(StrideFlags::GAP))
+                .filter(|s| s.0.flags.has(StrideFlags::GAP))
                 .count(),
             distance_m: strides
                 .iter()
-                .filter(|s| s.flags.valid())
-                .map(|s| s.length_mm as f64 / 1000.0)
+                .filter(|s| s.0.flags.valid())
+                .map(|s| s.0.length_mm as f64 / 1000.0)
                 .sum(),
             nominal_rate_hz: self.nominal_hz,
             clock_rate_hz: self.clock.rate_hz(),
@@ -371,7 +398,10 @@ pub fn replay_summarised(
     let clock = &prepared.clock;
     let mut out: Vec<StrideReport> = strides
         .into_iter()
-        .map(|s| report(s, config, &|n| clock.t_s(n)))
+        .map(|(s, stats)| StrideReport {
+            stats,
+            ..report(s, config, &|n| clock.t_s(n))
+        })
         .collect();
     if all_models && detector == Detector::Stance {
         for r in &mut out {
@@ -379,7 +409,7 @@ pub fn replay_summarised(
                 // No length across a gap, from any model.
                 continue;
             }
-            let f = Features::of(&r.raw, rate);
+            let f = Features::of(&r.raw, &r.stats, rate);
             r.lengths_m = Some(
                 Model::ALL
                     .iter()
@@ -412,5 +442,6 @@ fn report(s: Stride, config: Config, t_s: &impl Fn(u32) -> f64) -> StrideReport 
         valid: s.flags.valid(),
         flags: flag_names(s.flags),
         raw: s,
+        stats: StrideStats::EMPTY,
     }
 }

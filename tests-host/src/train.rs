@@ -22,7 +22,7 @@ use std::path::Path;
 use anyhow::{bail, Context, Result};
 use gaitclip::features::{self, Features, COUNT, PER_SEGMENT, ZUPT_LENGTH};
 use gaitclip::models::{Model, ModelParams, Settings, LINEAR_MODELS, MAX_TERMS};
-use gaitclip::phase_stats::{Channel, Segment};
+use gaitclip::phase_stats::{Channel, Segment, StrideStats};
 use gaitclip::pipeline::DEFAULT_MODEL;
 use gaitclip::rate::SampleRate;
 use gaitclip::stride::Stride;
@@ -66,6 +66,8 @@ pub struct TrialRun {
     pub rate: SampleRate,
     /// The core's strides whose movement's middle lies in the trial's annotated span.
     pub strides: Vec<Stride>,
+    /// Their phase statistics.
+    pub stats: Vec<StrideStats>,
     /// Their f64 features.
     pub x: Vec<[f64; COUNT]>,
     /// Their fixed-point features.
@@ -88,18 +90,18 @@ pub fn run_dataset(dataset: &Dataset) -> Result<Vec<TrialRun>> {
         let prepared =
             replay::prepare(&trace, ranges).with_context(|| format!("{}", trial.csv.display()))?;
         let rate = prepared.rate;
-        let all = prepared.strides(prepared.config(ranges));
+        let all = prepared.strides_with_stats(prepared.config(ranges));
         let span = trial.span_in_numbers(&prepared.clock);
         let references = trial.references_in_numbers(&prepared.clock);
-        let strides: Vec<Stride> = all
+        let (strides, stats): (Vec<Stride>, Vec<StrideStats>) = all
             .into_iter()
             // A stride belongs to the span when its movement's middle does: a first step
             // that ends just inside the reference's first stride is not in it.
-            .filter(|s| {
+            .filter(|(s, _)| {
                 let mid = s.heel_off / 2 + s.end / 2;
                 mid >= span.0 && mid < span.1
             })
-            .collect();
+            .unzip();
         let det: Vec<Detected> = strides.iter().map(Detected::from).collect();
         let mut reference = vec![None; strides.len()];
         for (i, j) in eval::match_strides(&det, &references) {
@@ -121,10 +123,16 @@ pub fn run_dataset(dataset: &Dataset) -> Result<Vec<TrialRun>> {
             rate,
             x: strides
                 .iter()
-                .map(|s| length_ref::features(s, rate))
+                .zip(&stats)
+                .map(|(s, st)| length_ref::features(s, st, rate))
                 .collect(),
-            fixed: strides.iter().map(|s| Features::of(s, rate)).collect(),
+            fixed: strides
+                .iter()
+                .zip(&stats)
+                .map(|(s, st)| Features::of(s, st, rate))
+                .collect(),
             strides,
+            stats,
             reference,
             reference_total_m,
             settings,

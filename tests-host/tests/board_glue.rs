@@ -63,7 +63,7 @@ impl BusRecovery for FlakyBus {
 /// Runs `pulses` data-ready interrupts; returns the items and the counters.
 fn run(fail: std::ops::Range<usize>, pulses: usize) -> (Vec<Item>, Counters) {
     let bus = FlakyBus {
-        inner: ReplayMpu6050::new(0x68, trace()),
+        inner: ReplayMpu6050::new(0x68, trace(), &[]),
         fail,
         transactions: 0,
         recoveries: 0,
@@ -146,7 +146,7 @@ fn a_sensor_that_stops_answering_is_restarted_and_the_hole_is_a_gap() {
 #[test]
 fn a_full_queue_becomes_a_gap_not_a_silent_loss() {
     let bus = FlakyBus {
-        inner: ReplayMpu6050::new(0x68, trace()),
+        inner: ReplayMpu6050::new(0x68, trace(), &[]),
         fail: 0..0,
         transactions: 0,
         recoveries: 0,

@@ -20,7 +20,7 @@ fn driver_reads_the_trace_through_the_emulated_bus() {
     )
     .unwrap()
     .leak();
-    let mut imu = Mpu6050::new(ReplayMpu6050::new(0x68, bytes), Address::Ad0Low);
+    let mut imu = Mpu6050::new(ReplayMpu6050::new(0x68, bytes, &[]), Address::Ad0Low);
     imu.init(
         &mut NoopDelay,
         &Config::new(OutputRate::from_hz(200).unwrap()),
@@ -43,7 +43,7 @@ fn driver_reads_the_trace_through_the_emulated_bus() {
 
 #[test]
 fn wrong_address_does_not_answer() {
-    let mut imu = Mpu6050::new(ReplayMpu6050::new(0x68, &[]), Address::Ad0High);
+    let mut imu = Mpu6050::new(ReplayMpu6050::new(0x68, &[], &[]), Address::Ad0High);
     assert_eq!(
         imu.probe().unwrap_err(),
         Error::Bus(ReplayBusError::NoDevice)

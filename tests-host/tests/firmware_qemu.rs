@@ -5,10 +5,121 @@
 
 use gaitclip::pipeline::{Config, Detector};
 use gaitclip::rate::SampleRate;
+use gaitclip::sample::RawSample;
+use gaitclip::stride::{Stride, StrideFlags};
+use gaitclip_host::clock::Gap;
 use gaitclip_host::firmware::{self, parse_stride_line, LoggedStride};
 use gaitclip_host::qemu::{self, RunOptions};
-use gaitclip_host::replay::replay_counts_with;
+use gaitclip_host::replay::{core_strides_gapped, replay_counts_with};
 use gaitclip_host::trace::Ranges;
+
+#[path = "../../boards/common/replay_holes.rs"]
+mod replay_holes;
+
+fn logged(s: &Stride) -> LoggedStride {
+    LoggedStride {
+        index: s.index,
+        idx: [s.start, s.heel_off, s.toe_off, s.heel_strike, s.end],
+        length_mm: s.length_mm,
+        climb_mm: s.climb_mm,
+        flags: s.flags.0,
+    }
+}
+
+/// The micro:bit firmware with the emulated sensor losing the runs of
+/// `boards/common/replay_holes.rs` (a hole of every kind: bridged in swings and in a stance,
+/// filled, and one that restarts detection) logs exactly the strides of the host replay of
+/// the same samples with the same holes declared.
+#[test]
+fn qemu_m0_bridges_holes_as_the_host_replay() {
+    if !qemu::available_or_skip() {
+        return;
+    }
+    let env = [("CARGO_TARGET_DIR", "target/replay-holes".as_ref())];
+    let elf = firmware::build_with(
+        "boards/microbit",
+        "microbit",
+        "thumbv6m-none-eabi",
+        &["--features", "replay-holes"],
+        &env,
+    )
+    .expect("firmware builds");
+    let out = qemu::run(
+        &elf,
+        &RunOptions {
+            machine: qemu::MACHINE_M0.into(),
+            fast: true,
+            extra_args: Vec::new(),
+        },
+        |_| {},
+    )
+    .expect("qemu runs");
+    assert_eq!(out.status, 0, "log:\n{}", out.lines.join("\n"));
+    let on_target: Vec<LoggedStride> = out
+        .lines
+        .iter()
+        .filter_map(|l| parse_stride_line(l))
+        .collect();
+
+    // The host: the same counts without the lost samples, each run declared as a gap.
+    let all = gaitclip_host::fixtures::firmware_trace_counts().unwrap();
+    let (mut counts, mut gaps): (Vec<RawSample>, Vec<Gap>) = (Vec::new(), Vec::new());
+    let mut lost = replay_holes::LOST.iter().peekable();
+    let mut n = 0usize;
+    while n < all.len() {
+        if let Some(&(_, len)) = lost.next_if(|h| h.0 as usize == n) {
+            gaps.push(Gap {
+                before: counts.len(),
+                missing: len,
+            });
+            n += len as usize;
+            continue;
+        }
+        counts.push(all[n]);
+        n += 1;
+    }
+    let ranges = Ranges::default();
+    let config = Config::new(SampleRate::from_hz(200).unwrap(), ranges.accel, ranges.gyro);
+    let host_strides = core_strides_gapped(&counts, &gaps, config);
+    let host: Vec<LoggedStride> = host_strides.iter().map(logged).collect();
+    assert_eq!(on_target, host);
+    // Every kind of hole is there: bridged strides that keep their length, a gap stride
+    // (the filled hole and the restart).
+    let bridged = host_strides
+        .iter()
+        .filter(|s| s.flags.has(StrideFlags::BRIDGED) && s.flags.valid())
+        .count();
+    let gap = host_strides
+        .iter()
+        .filter(|s| s.flags.has(StrideFlags::GAP))
+        .count();
+    assert!(
+        bridged >= 3 && gap == 2,
+        "{bridged} bridged, {gap} gap: {host_strides:#?}"
+    );
+    let summary = out
+        .lines
+        .iter()
+        .find(|l| l.starts_with("summary"))
+        .expect("summary line");
+    let lost: u32 = replay_holes::LOST.iter().map(|h| h.1).sum();
+    assert!(
+        summary.contains(&format!("lost_samples={lost}")),
+        "{summary}"
+    );
+    assert!(
+        summary.contains(&format!("samples={}", counts.len())),
+        "{summary}"
+    );
+    for kind in ["bridged", "filled", "detection restarts"] {
+        assert!(
+            out.lines
+                .iter()
+                .any(|l| l.starts_with("hole of") && l.contains(kind)),
+            "no `{kind}` hole in the log"
+        );
+    }
+}
 
 #[test]
 fn qemu_m4_strides_equal_host_replay() {

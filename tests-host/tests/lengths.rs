@@ -131,7 +131,7 @@ fn lu_rule_base_reads_as_the_paper_says() {
 }
 
 /// Random strides: a random movement buffer split at random phases.
-fn random_strides(n: usize) -> Vec<Stride> {
+fn random_strides(n: usize) -> Vec<(Stride, StrideStats)> {
     let mut r = rng();
     (0..n)
         .map(|_| {
@@ -143,14 +143,16 @@ fn random_strides(n: usize) -> Vec<Stride> {
             let to = r.random_range(0..=len as u32);
             let hs = r.random_range(to..=len as u32);
             let stance = r.random_range(0..300u32);
-            Stride {
-                start: 1000,
-                heel_off: 1000 + stance,
-                end: 1000 + stance + len as u32,
-                zupt_um: r.random_range(0..3_000_000),
-                stats: StrideStats::measure(&m, to, hs),
-                ..Stride::default()
-            }
+            (
+                Stride {
+                    start: 1000,
+                    heel_off: 1000 + stance,
+                    end: 1000 + stance + len as u32,
+                    zupt_um: r.random_range(0..3_000_000),
+                    ..Stride::default()
+                },
+                StrideStats::measure(&m, to, hs),
+            )
         })
         .collect()
 }
@@ -159,9 +161,9 @@ fn random_strides(n: usize) -> Vec<Stride> {
 fn features_match_f64_reference() {
     let rate = SampleRate::from_millihertz(204_800).unwrap();
     let mut max = [0f64; COUNT];
-    for s in random_strides(2000) {
-        let fixed = Features::of(&s, rate);
-        let want = length_ref::features(&s, rate);
+    for (s, stats) in random_strides(2000) {
+        let fixed = Features::of(&s, &stats, rate);
+        let want = length_ref::features(&s, &stats, rate);
         for i in 0..COUNT {
             let got = fixed.0[i] as f64 / Q16;
             let (seg, ch, stat) = features::name_parts(i);
@@ -185,9 +187,9 @@ fn basis_terms_match_f64_reference() {
         params.lu_d_range_q16.1 as f64 / Q16,
     );
     let settings = Settings { height_mm: 1712 };
-    for s in random_strides(500) {
-        let fixed = Features::of(&s, rate);
-        let want = length_ref::features(&s, rate);
+    for (s, stats) in random_strides(500) {
+        let fixed = Features::of(&s, &stats, rate);
+        let want = length_ref::features(&s, &stats, rate);
         for m in Model::ALL {
             let (Some(b), Some(w)) = (
                 models::basis(m, &fixed, settings, params),

@@ -36,8 +36,8 @@ fn shipped_models_are_current_exact_and_meet_targets() {
     let mut worst = (0.0f64, "", 0usize);
     let mut n = 0usize;
     for run in &runs {
-        for (x, s) in run.x.iter().zip(&run.strides) {
-            let f = Features::of(s, run.rate);
+        for ((x, s), stats) in run.x.iter().zip(&run.strides).zip(&run.stats) {
+            let f = Features::of(s, stats, run.rate);
             for m in Model::ALL {
                 let fixed_m = models::predict_um(m, &f, run.settings, &gaitclip::trained::PARAMS)
                     .unwrap() as f64
