@@ -34,7 +34,7 @@ use crate::phases::PhaseMethod;
 use crate::rate::SampleRate;
 use crate::rest::{RestDetector, RestThresholds};
 use crate::sample::{AccelRange, GyroRange, RawSample};
-use crate::stance::{StanceDetector, StanceThresholds};
+use crate::stance::{StanceDetector, StanceLimits, StanceThresholds};
 use crate::stride::{
     Origin, Stride, StrideFlags, StrideTracker, MAX_MOVEMENT_SAMPLES, MAX_STRIDE_MM,
     MIN_MOVEMENT_MS,
@@ -120,6 +120,9 @@ pub struct Config {
     /// Longest hole bridged, ms ([`BRIDGE_MAX_MS`]; clamped to [`FILL_MAX_MS`]). A setting
     /// so that the hole-length sweep can measure what each limit costs.
     pub bridge_max_ms: u32,
+    /// The stance detector's thresholds ([`StanceLimits::DEFAULT`]); a setting for the
+    /// threshold sweep of [`crate::stance`].
+    pub stance: StanceLimits,
 }
 
 impl Config {
@@ -137,6 +140,7 @@ impl Config {
             settings: Settings::DEFAULT,
             params: &crate::trained::PARAMS,
             bridge_max_ms: BRIDGE_MAX_MS,
+            stance: StanceLimits::DEFAULT,
         }
     }
 
@@ -296,7 +300,11 @@ impl<const M: usize> Pipeline<M> {
         let filter =
             MeanFilter::with_len_log2(log2_nearest(config.rate.samples_in_ms(MEAN_FILTER_MS)));
         let rest = RestDetector::new(RestThresholds::new(config.rate, config.accel, config.gyro));
-        let stance = StanceDetector::new(StanceThresholds::new(config.rate, config.gyro));
+        let stance = StanceDetector::new(StanceThresholds::with_limits(
+            config.rate,
+            config.gyro,
+            config.stance,
+        ));
         let rest_delay = rest.delay() + filter.delay();
         let delay = stance.delay() + filter.delay();
         Pipeline {

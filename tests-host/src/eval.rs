@@ -936,6 +936,47 @@ pub fn table(results: &[DatasetResult]) -> String {
     s
 }
 
+/// What the recordings' stamps and holes cost, per dataset: the replay's summaries
+/// ([`crate::replay::Summary`]) of every trial added up.
+pub fn data_table(datasets: &[Dataset]) -> Result<String> {
+    let mut s = String::from(
+        "| dataset | trials | samples read | repeated samples dropped | trials with holes | holes (samples lost) | bridged holes (samples) | gap holes: filled / restart (samples) | strides | bridged strides | gap strides | trials re-timed (stamps off the clock) |\n|---|---:|---:|---:|---:|---|---|---|---:|---:|---:|---|\n",
+    );
+    for d in datasets {
+        let mut t = crate::replay::Summary::default();
+        let (mut holed, mut retimed) = (0, 0);
+        for trial in &d.trials {
+            let trace = csv_trace::read(&trial.csv, Some(d.rate_hz))?;
+            let p = crate::replay::prepare(&trace, Ranges::default())
+                .with_context(|| format!("{}", trial.csv.display()))?;
+            let (_, one) = p.run(p.config(Ranges::default()));
+            holed += (one.holes > 0) as usize;
+            retimed += (one.retimed_stamps > 0) as usize;
+            t.add(&one);
+        }
+        let _ = writeln!(
+            s,
+            "| {} | {} | {} | {} | {holed} | {} ({}) | {} ({}) | {} / {} ({}) | {} | {} | {} | {retimed} ({}) |",
+            d.name,
+            d.trials.len(),
+            t.samples_read,
+            t.repeated_dropped,
+            t.holes,
+            t.lost_samples,
+            t.bridged,
+            t.bridged_samples,
+            t.gaps_filled,
+            t.gaps - t.gaps_filled,
+            t.gap_samples,
+            t.strides,
+            t.bridged_strides,
+            t.gap_strides,
+            t.retimed_stamps,
+        );
+    }
+    Ok(s)
+}
+
 /// Step detection side by side: one row per dataset and detector (the `Tally` of each, as
 /// recorded), with Lu's eq. 13 step-count error as the mean over trials and pooled.
 pub fn detectors_table(rows: &[(&str, &str, &Tally)]) -> String {

@@ -31,7 +31,7 @@ pub enum ReplayError {
 
 /// What was done to a recording's samples before and while the core measured them: the
 /// last line or record of `replay`.
-#[derive(Clone, Debug, PartialEq, Serialize)]
+#[derive(Clone, Debug, Default, PartialEq, Serialize)]
 pub struct Summary {
     /// Samples read from the file.
     pub samples_read: usize,
@@ -76,6 +76,25 @@ pub struct Summary {
 }
 
 impl Summary {
+    /// Adds the counts of `o` (the clock fields are left as they are).
+    pub fn add(&mut self, o: &Summary) {
+        self.samples_read += o.samples_read;
+        self.repeated_dropped += o.repeated_dropped;
+        self.holes += o.holes;
+        self.lost_samples += o.lost_samples;
+        self.bridged += o.bridged;
+        self.bridged_samples += o.bridged_samples;
+        self.gaps += o.gaps;
+        self.gap_samples += o.gap_samples;
+        self.gaps_filled += o.gaps_filled;
+        self.strides += o.strides;
+        self.valid_strides += o.valid_strides;
+        self.bridged_strides += o.bridged_strides;
+        self.gap_strides += o.gap_strides;
+        self.distance_m += o.distance_m;
+        self.retimed_stamps += o.retimed_stamps;
+    }
+
     /// The summary as one line of text.
     pub fn line(&self) -> String {
         let mut s = format!(

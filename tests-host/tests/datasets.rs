@@ -102,7 +102,7 @@ fn eval_figures_on_recordings() {
     for (name, f1, to, hs, iou) in [
         ("gaitmap_walk", 0.97, 30.0, 70.0, 0.80),
         ("pyshoe_vicon", 0.87, f64::NAN, f64::NAN, f64::NAN),
-        ("ipol_gait_events", 0.94, 45.0, 35.0, 0.82),
+        ("ipol_gait_events", 0.97, 45.0, 35.0, 0.82),
     ] {
         let d = eval::load(&root.join(name)).unwrap();
         let r = eval::evaluate(&d, &detector, 0, 1).unwrap();

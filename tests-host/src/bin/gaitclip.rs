@@ -68,6 +68,10 @@ enum Cmd {
         /// (SVG) into this folder.
         #[arg(long, value_name = "DIR")]
         plots: Option<PathBuf>,
+        /// The stance detector's thresholds for the detection tables, as
+        /// `STD,IQR,GYRO` in (m/s²)², (m/s²)² and rad/s (default: the shipped 6,6,0.7).
+        #[arg(long, value_name = "STD,IQR,GYRO", value_parser = stance_limits)]
+        stance: Option<gaitclip::stance::StanceLimits>,
     },
     /// Train every stride-length model on the shared datasets with per-stride lengths and
     /// write the generated Rust source the firmware compiles.
@@ -127,6 +131,26 @@ impl From<PhasesArg> for PhaseMethod {
             PhasesArg::MajorPairs => PhaseMethod::MajorPairs,
             PhasesArg::Augmented => PhaseMethod::Augmented,
         }
+    }
+}
+
+fn stance_limits(v: &str) -> Result<gaitclip::stance::StanceLimits, String> {
+    let parts: Vec<f64> = v
+        .split(',')
+        .map(|x| x.trim().parse::<f64>().map_err(|e| format!("{x:?}: {e}")))
+        .collect::<Result<_, _>>()?;
+    let milli = |x: f64| -> Result<u32, String> {
+        (x.is_finite() && x > 0.0 && x < 4e6)
+            .then(|| (x * 1000.0).round() as u32)
+            .ok_or_else(|| format!("{x} is not a positive threshold"))
+    };
+    match parts[..] {
+        [std, iqr, gyro] => Ok(gaitclip::stance::StanceLimits {
+            std_milli: milli(std)?,
+            iqr_milli: milli(iqr)?,
+            gyro_mradps: milli(gyro)?,
+        }),
+        _ => Err("three numbers: STD,IQR,GYRO".into()),
     }
 }
 
@@ -306,25 +330,34 @@ fn run(cli: Cli) -> anyhow::Result<()> {
             seed,
             phases,
             plots,
+            stance,
         } => {
             let run_with = |which: Detector| {
                 eval::core_detector(move |c: &mut Config| {
                     c.phases = phases.into();
                     c.detector = which;
+                    if let Some(limits) = stance {
+                        c.stance = limits;
+                    }
                 })
             };
             let (stance, lu) = (run_with(Detector::Stance), run_with(Detector::PeakValley));
             let mut results = Vec::new();
             let mut side_by_side = Vec::new();
             let mut runs = Vec::new();
+            let mut loaded = Vec::new();
             for dir in &datasets {
                 let d = eval::load(dir)?;
+                loaded.push(d.clone());
                 let by_stance = eval::evaluate(&d, &stance, rotate, seed)?;
                 let by_lu = eval::evaluate(&d, &lu, 0, seed)?;
                 side_by_side.push((d.name.clone(), by_stance.tally.clone(), by_lu.tally));
                 results.push(by_stance);
                 runs.extend(train::run_dataset(&d)?);
             }
+            println!("The recordings as read (stamps, repeated samples, holes and what the core did with them):\n");
+            print!("{}", eval::data_table(&loaded)?);
+            println!();
             print!("{}", eval::table(&results));
             let rows: Vec<(&str, &str, &eval::Tally)> = side_by_side
                 .iter()
