@@ -36,6 +36,11 @@
 //! code therefore gives bit-identical strides on a Cortex-M0 without an FPU, on a Cortex-M4,
 //! and on the host that replays recordings; tests compare the two.
 //!
+//! **Holes are bridged, not measured across.** A lost packet or a FIFO overflow reaches the
+//! pipeline as [`pipeline::Pipeline::gap`]: a short hole is interpolated ([`bridge`]) and the
+//! stride keeps its length (flagged), a longer one makes the stride across it a gap stride
+//! without a length, so that nothing is silently measured across missing samples.
+//!
 //! **No heap, no panics, bounded state.** Every buffer is a compile-time capacity
 //! ([`stance::RING_CAPACITY`], [`pipeline::DELAY_CAPACITY`],
 //! [`stride::MAX_MOVEMENT_SAMPLES`]); a movement longer than its buffer is flagged, never

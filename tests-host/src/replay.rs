@@ -98,7 +98,7 @@ impl Summary {
     /// The summary as one line of text.
     pub fn line(&self) -> String {
         let mut s = format!(
-            "summary: {} strides ({} valid, {} bridged, {} gap), {:.3} m; {} samples read, {} repeated dropped; {} holes ({} samples lost): {} bridged ({} samples), {} gaps ({} samples, {} of them filled for their events); clock {:.4} Hz (nominal {:.4} Hz, {:+.1} ppm), first sample at {:.6} s, core at {:.3} Hz",
+            "summary: {} strides ({} valid, {} bridged, {} gap), {:.3} m; {} samples read, {} repeated dropped; {} holes ({} samples lost): {} bridged ({} samples), {} left as gaps ({} samples; {} filled for their events); clock {:.4} Hz (nominal {:.4} Hz, {:+.1} ppm), first sample at {:.6} s, core at {:.3} Hz",
             self.strides,
             self.valid_strides,
             self.bridged_strides,
@@ -115,7 +115,8 @@ impl Summary {
             self.gaps_filled,
             self.clock_rate_hz,
             self.nominal_rate_hz,
-            (self.clock_rate_hz / self.nominal_rate_hz - 1.0) * 1e6,
+            // No "-0.0 ppm" for a clock on its nominal rate.
+            ((self.clock_rate_hz / self.nominal_rate_hz - 1.0) * 1e6 * 10.0).round() / 10.0 + 0.0,
             // No "-0.000000 s" for an offset that is zero to print precision.
             if self.clock_offset_s.abs() < 5e-7 {
                 0.0
