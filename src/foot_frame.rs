@@ -26,7 +26,7 @@ use nalgebra::{Matrix3, SymmetricEigen, Vector3};
 
 use crate::rate::SampleRate;
 use crate::rest::RestSums;
-use crate::sample::{AccelRange, RawSample};
+use crate::sample::{AccelRange, GyroRange, RawSample};
 
 /// A rest period whose gravity direction is further than this from the current up axis
 /// means the clip was moved: the frame starts again.
@@ -38,6 +38,22 @@ pub const AXIS_MAX_MOVEMENT_MS: u32 = 2500;
 /// The very first frame is set once the first rest has lasted this long, so that the stance
 /// detector is running before the first step (later rests update it when they end).
 pub const FIRST_FRAME_AFTER_MS: u32 = 100;
+/// The cycle detector's calibration (gyro bias, gravity: [`FootFrameEstimator::still_calibration`])
+/// comes from blocks this long inside rests: the stillest, not the whole rest, because the
+/// rest detector's rests take in a settling foot or a slow shift of weight (a steady 3 °/s
+/// over a 1.6 s "rest" in one `pyshoe_vicon` trial, 0.2 rad/s of wobble at the start of an
+/// `ipol_gait_events` one), whose mean is no bias.
+pub const STILL_BLOCK_MS: u32 = 250;
+/// A block whose angular rate spreads by less than this (all axes together) is standing
+/// still: 0.05 rad/s (3 °/s); a walking stance's rolling foot spreads by 0.1–0.3 rad/s. The
+/// latest such block calibrates; until one comes, the steadiest block so far (or the
+/// steadiest rest shorter than a block).
+pub const STILL_GYRO_STD_MRADPS: u32 = 50;
+/// …and whose gravity turns slower than this between its halves: 0.02 rad/s (1.1 °/s). A
+/// steady slow rotation (a foot rolling onto its toes, a shift of weight) has no spread, but
+/// turns gravity; its mean rate is no bias. (Accelerometer noise turns the halves' means of a
+/// 250 ms block at 100 Hz by ≈ 0.001 rad, a third of this rate's 0.0025 rad.)
+pub const STILL_TILT_MRADPS: u32 = 20;
 /// Foot-frame accelerations are in units of g/[`FOOT_LSB_PER_G`] whatever the sensor's
 /// range: the counts of the ±16 g range.
 pub const FOOT_LSB_PER_G: i32 = 2048;
@@ -90,6 +106,12 @@ impl FootFrame {
         self.rows.map(|r| r.map(|v| v as f32 / scale))
     }
 
+    /// The up axis as a row of the rotation (sensor axes, Q14 with the range scaling): the
+    /// foot's standing up, for a direction test.
+    pub const fn up_row(&self) -> [i32; 3] {
+        self.rows[2]
+    }
+
     /// Gravity measured at rest, in g/2048.
     pub const fn gravity(&self) -> i32 {
         self.gravity
@@ -101,6 +123,17 @@ impl FootFrame {
     }
 }
 
+/// The block of a rest the cycle detector is calibrated from.
+#[derive(Clone, Copy, Debug)]
+struct StillBlock {
+    gyro_bias: [i32; 3],
+    gravity_counts: i32,
+    /// Its angular rate's variance, counts² (all axes).
+    gyro_variance: u64,
+    /// A whole block within [`STILL_GYRO_STD_MRADPS`].
+    qualified: bool,
+}
+
 /// Learns the foot frame from rest periods and movements.
 #[derive(Clone, Debug)]
 pub struct FootFrameEstimator {
@@ -108,7 +141,16 @@ pub struct FootFrameEstimator {
     axis_min: u32,
     axis_max: u32,
     first_after: u32,
+    /// Samples of [`STILL_BLOCK_MS`].
+    block_len: u32,
+    /// [`STILL_GYRO_STD_MRADPS`]² in counts².
+    still_variance: u64,
     frame: Option<FootFrame>,
+    /// The calibration block ([`STILL_BLOCK_MS`]).
+    still: Option<StillBlock>,
+    /// The block of the rest in progress, and its first half's force sums.
+    block: RestSums,
+    block_half: [i64; 3],
     up: [f32; 3],
     gravity_counts: f32,
     left_sum: [f32; 3],
@@ -125,13 +167,19 @@ pub struct FootFrameEstimator {
 
 impl FootFrameEstimator {
     /// An estimator that knows nothing yet.
-    pub const fn new(rate: SampleRate, accel: AccelRange) -> Self {
+    pub const fn new(rate: SampleRate, accel: AccelRange, gyro: GyroRange) -> Self {
+        let still_std = gyro.counts_of_mrad_per_s(STILL_GYRO_STD_MRADPS) as u64;
         FootFrameEstimator {
             accel,
             axis_min: rate.samples_in_ms(AXIS_MIN_MOVEMENT_MS),
             axis_max: rate.samples_in_ms(AXIS_MAX_MOVEMENT_MS),
             first_after: rate.samples_in_ms(FIRST_FRAME_AFTER_MS),
+            block_len: rate.samples_in_ms(STILL_BLOCK_MS),
+            still_variance: still_std * still_std,
             frame: None,
+            still: None,
+            block: RestSums::new(),
+            block_half: [0; 3],
             up: [0.0; 3],
             gravity_counts: 0.0,
             left_sum: [0.0; 3],
@@ -151,6 +199,72 @@ impl FootFrameEstimator {
         self.frame
     }
 
+    /// Gyroscope bias and gravity magnitude, counts, from the latest still block of a rest
+    /// ([`STILL_BLOCK_MS`], [`STILL_GYRO_STD_MRADPS`]; until there is one, the steadiest so
+    /// far): standing still, not a walking stance. `None` before the first block or rest.
+    pub const fn still_calibration(&self) -> Option<([i32; 3], i32)> {
+        match self.still {
+            Some(s) => Some((s.gyro_bias, s.gravity_counts)),
+            None => None,
+        }
+    }
+
+    /// Whether gravity kept its direction over the block `b` (its halves within
+    /// [`STILL_TILT_MRADPS`] × half the block).
+    fn block_level(&self, b: &RestSums) -> bool {
+        let first = Vector3::from(self.block_half.map(|v| v as f32));
+        let second = Vector3::from([0, 1, 2].map(|k| (b.accel[k] - self.block_half[k]) as f32));
+        let (n1, n2) = (first.norm(), second.norm());
+        if n1 <= 0.0 || n2 <= 0.0 {
+            return false;
+        }
+        let sin = first.cross(&second).norm() / (n1 * n2);
+        let max = STILL_TILT_MRADPS as f32 * 1e-3 * STILL_BLOCK_MS as f32 * 0.5e-3;
+        sin <= max
+    }
+
+    /// Offers the block for calibration and starts the next.
+    fn end_block(&mut self) {
+        let b = core::mem::replace(&mut self.block, RestSums::new());
+        if b.count == 0 {
+            return;
+        }
+        let variance = b.gyro_variance();
+        let qualified =
+            b.count >= self.block_len && variance <= self.still_variance && self.block_level(&b);
+        let n = b.count as i64;
+        let mean = |v: i64| (v + n / 2).div_euclid(n);
+        let a = b.accel.map(|v| mean(v) as f32);
+        let g = libm_round(Vector3::from(a).norm());
+        if g <= 0 {
+            return;
+        }
+        let new = StillBlock {
+            gyro_bias: b.gyro.map(|v| mean(v) as i32),
+            gravity_counts: g,
+            gyro_variance: variance,
+            qualified,
+        };
+        self.still = match self.still {
+            None => Some(new),
+            // Until a still block comes, the steadiest whole block (a rest shorter than a
+            // block serves only as the first calibration).
+            Some(s) if !s.qualified => {
+                let steadier = b.count >= self.block_len && variance < s.gyro_variance;
+                Some(if qualified || steadier { new } else { s })
+            }
+            // Still blocks are averaged in slowly: the bias drifts with temperature over
+            // minutes, while one block can hold a slow turn about gravity that neither
+            // the spread nor the tilt shows (a foot pivoting on the spot).
+            Some(s) if qualified => Some(StillBlock {
+                gyro_bias: [0, 1, 2].map(|k| blend(s.gyro_bias[k], new.gyro_bias[k])),
+                gravity_counts: blend(s.gravity_counts, new.gravity_counts),
+                ..s
+            }),
+            keep => keep,
+        };
+    }
+
     /// Gyroscope bias, counts: the mean angular rate of the last rest period (zero before
     /// the first). The movement axis is learnt from the rates minus this bias.
     pub const fn gyro_bias(&self) -> [i32; 3] {
@@ -167,6 +281,7 @@ impl FootFrameEstimator {
             }
             (true, true) => self.accumulate_rest(s),
             (true, false) => {
+                self.end_block();
                 self.end_rest();
                 self.cov = [0; 6];
                 self.sum_w = [0; 3];
@@ -190,6 +305,13 @@ impl FootFrameEstimator {
 
     fn accumulate_rest(&mut self, s: &RawSample) {
         self.rest.add(s);
+        self.block.add(s);
+        if self.block.count == self.block_len / 2 {
+            self.block_half = self.block.accel;
+        }
+        if self.block.count >= self.block_len {
+            self.end_block();
+        }
         if self.frame.is_none() && self.rest.count == self.first_after {
             self.end_rest();
         }
@@ -321,6 +443,17 @@ impl FootFrameEstimator {
 }
 
 /// Round to nearest, for values well inside `i32` (matrix entries and gravity).
+/// One still block's weight in the calibration, 1/2^[`STILL_BLEND_SHIFT`]: the bias settles
+/// over ≈ 8 blocks (2 s of standing) and one pivot moves it by an eighth.
+const STILL_BLEND_SHIFT: u32 = 3;
+
+/// `old + (new − old) / 2^STILL_BLEND_SHIFT`, rounded to nearest.
+fn blend(old: i32, new: i32) -> i32 {
+    let d = new as i64 - old as i64;
+    let half = 1i64 << (STILL_BLEND_SHIFT - 1);
+    (old as i64 + ((d + half) >> STILL_BLEND_SHIFT)) as i32
+}
+
 fn libm_round(v: f32) -> i32 {
     if v >= 0.0 {
         (v + 0.5) as i32

@@ -16,20 +16,27 @@
 //! 3. [`foot_frame`] — which way is up (gravity in the rests that the orientation-free
 //!    [`rest`] test finds) and which way is forward (the axis the foot pitches about in its
 //!    steps); every sample is rotated into that frame by an integer matrix.
-//! 4. [`stance`] — is the foot flat? Huang's deflated variance and interquartile range of
-//!    vertical and sagittal acceleration over three windows, with angular-rate energy.
-//! 5. [`stride`] — stance-to-stance segmentation and its flags, Huang's [`phases`] splitter
-//!    for toe-off and heel-strike, [`zupt`] strapdown integration with zero-velocity
-//!    updates, and [`phase_stats`], the movement's acceleration summed phase by phase.
+//! 4. [`cycle`] — one zero-velocity instant per gait cycle, at every pace: the deepest
+//!    minimum of a SHOE-type energy (angular-rate energy plus |f| − g) between two swings,
+//!    found relative to the cycle rather than under a fixed threshold, and confirmed by
+//!    physics (the integrated attitude's up agrees with gravity, the foot is near flat).
+//!    Strides run from instant to instant; the [`zupt`] strapdown integration imposes the
+//!    rolling-contact velocity `ω × (h·up)` at each instant, and puts back the tilt a
+//!    clipped gyro lost. Huang's [`phases`] splitter gives toe-off and heel-strike, and
+//!    [`phase_stats`] sums the movement's acceleration phase by phase.
+//! 5. [`stance`] and [`stride`] — Huang's variance + IQR stance detector and its
+//!    stance-to-stance segmentation, kept selectable as the paper's method for the
+//!    side-by-side tables ([`pipeline::Detector::Stance`]).
 //! 6. [`features`] — Huang's per-phase features (Table 2) in Q16.
 //! 7. [`models`] — every paper's stride-length model side by side ([`fuzzy`] for Lu's K,
 //!    [`svr`] for Huang's RBF SVRs), with the coefficients and support vectors that
 //!    `gaitclip train` writes into [`trained`]; the pipeline's model fills in the length.
 //!
 //! [`pipeline::Pipeline`] composes them; a board or a host tool only feeds samples and
-//! reads strides. In place of stages 4–5 it can run Lu's [`peak_valley`] detector on the
-//! vertical acceleration (after the [`low_pass`]), whose steps Lu's own chain measures
-//! ([`pipeline::Detector`]); the stance detector is the default.
+//! reads strides. In place of stage 4 it can run Huang's stance detector (stage 5) or Lu's
+//! [`peak_valley`] detector on the vertical acceleration (after the [`low_pass`]), whose
+//! steps Lu's own chain measures ([`pipeline::Detector`]); the cycle detector is the
+//! default, because it alone gives every cycle of a jog its stance.
 //!
 //! **Integer on the sample path.** The per-sample work is integer arithmetic with documented
 //! scaling ([`fixed`]): Q30 quaternions, counts·2⁸ accelerations, `i64` integrals. The same
@@ -66,6 +73,7 @@
 #![deny(missing_docs)]
 
 pub mod bridge;
+pub mod cycle;
 pub mod features;
 pub mod fixed;
 pub mod foot_frame;

@@ -12,8 +12,10 @@
 //! windows are undone by delay lines, so that every stride index is the number of the raw
 //! sample it names.
 //!
-//! **Two detectors.** [`Detector::Stance`] (the default) is the chain above.
-//! [`Detector::PeakValley`] replaces the stance detector and stride tracker with Lu's
+//! **Three detectors.** [`Detector::Cycle`] (the default) replaces the stance detector and
+//! stride tracker above by [`crate::cycle::CycleDetector`]: one zero-velocity instant per
+//! gait cycle, strides from instant to instant, the same phases, ZUPT and models.
+//! [`Detector::Stance`] is the chain above (Huang's method). [`Detector::PeakValley`] replaces the stance detector and stride tracker with Lu's
 //! peak-valley detector ([`crate::peak_valley`]) on the foot frame's vertical acceleration,
 //! and measures each of its steps with Lu's own chain, fuzzy `k` and Weinberg
 //! ([`crate::models::lu_chain_um`]):
@@ -24,8 +26,10 @@
 //! ```
 
 use crate::bridge;
+use crate::cycle::{Calibration, CycleConfig, CycleDetector};
 use crate::features::Features;
 use crate::foot_frame::FootFrameEstimator;
+use crate::foot_frame::FOOT_LSB_PER_G;
 use crate::mean_filter::MeanFilter;
 use crate::models::{self, Model, ModelParams, Settings};
 use crate::peak_valley::{PeakValleyDetector, Step};
@@ -62,15 +66,20 @@ pub const BRIDGE_MAX_MS: u32 = 30;
 pub const FILL_MAX_MS: u32 = MIN_MOVEMENT_MS;
 const _: () = assert!(BRIDGE_MAX_MS <= FILL_MAX_MS && FILL_MAX_MS <= MIN_MOVEMENT_MS);
 
-/// The model the firmware ships with as its stride length (see the README's length
-/// table for why).
-pub const DEFAULT_MODEL: Model = Model::HuangSvrFusion;
+/// The model the firmware ships with as its stride length: the one with the best
+/// leave-one-dataset-out score, as `gaitclip train` measured it
+/// ([`crate::trained::LODO_BEST`]; the README's length tables).
+pub const DEFAULT_MODEL: Model = crate::trained::LODO_BEST;
 
 /// Which step detector segments the walk.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Detector {
-    /// Stance to stance (Huang's zero-velocity detector), with gait events, phases, the
-    /// ZUPT displacement and every length model: the default.
+    /// One zero-velocity instant per gait cycle at every pace ([`crate::cycle`]), strides
+    /// from instant to instant with the rolling-contact ZUPT, events and phases by Huang's
+    /// splitter, every length model: the default.
+    Cycle,
+    /// Stance to stance (Huang's variance + IQR zero-velocity detector, the paper's
+    /// method), with gait events, phases, the ZUPT displacement and every length model.
     Stance,
     /// Lu's peak-valley detection on vertical acceleration, measured by Lu's chain whatever
     /// the configured model. A stride record is one of its steps: `start`, `heel_off` and
@@ -82,11 +91,12 @@ pub enum Detector {
 
 impl Detector {
     /// Both, default first.
-    pub const ALL: [Detector; 2] = [Detector::Stance, Detector::PeakValley];
+    pub const ALL: [Detector; 3] = [Detector::Cycle, Detector::Stance, Detector::PeakValley];
 
     /// The name `--detector` takes.
     pub const fn name(self) -> &'static str {
         match self {
+            Detector::Cycle => "cycle",
             Detector::Stance => "stance",
             Detector::PeakValley => "lu",
         }
@@ -123,6 +133,9 @@ pub struct Config {
     /// The stance detector's thresholds ([`StanceLimits::DEFAULT`]); a setting for the
     /// threshold sweep of [`crate::stance`].
     pub stance: StanceLimits,
+    /// The sensor's height above the foot's rolling contact, µm
+    /// ([`crate::cycle::SENSOR_HEIGHT_UM`]): where the clip sits on the shoe.
+    pub sensor_height_um: u32,
 }
 
 impl Config {
@@ -134,13 +147,14 @@ impl Config {
             rate,
             accel,
             gyro,
-            detector: Detector::Stance,
+            detector: Detector::Cycle,
             phases: PhaseMethod::Augmented,
             model: DEFAULT_MODEL,
             settings: Settings::DEFAULT,
             params: &crate::trained::PARAMS,
             bridge_max_ms: BRIDGE_MAX_MS,
             stance: StanceLimits::DEFAULT,
+            sensor_height_um: crate::cycle::SENSOR_HEIGHT_UM,
         }
     }
 
@@ -148,7 +162,7 @@ impl Config {
     /// Lu's fuzzy Weinberg (his whole chain) for the peak-valley detector.
     pub const fn length_model(&self) -> Model {
         match self.detector {
-            Detector::Stance => self.model,
+            Detector::Cycle | Detector::Stance => self.model,
             Detector::PeakValley => Model::LuFuzzy,
         }
     }
@@ -238,6 +252,7 @@ impl Released {
 #[derive(Clone, Debug)]
 #[allow(clippy::large_enum_variant)] // sharing the memory is the point
 enum Segmenter<const M: usize> {
+    Cycle(CycleDetector<M>),
     Stance {
         stance: StanceDetector,
         tracker: StrideTracker<M>,
@@ -254,6 +269,8 @@ pub struct Pipeline<const M: usize = MAX_MOVEMENT_SAMPLES> {
     frame: FootFrameEstimator,
     segmenter: Segmenter<M>,
     rate: SampleRate,
+    /// Accelerometer counts per g.
+    accel_lsb_per_g: i32,
     model: Model,
     settings: Settings,
     params: &'static ModelParams<'static>,
@@ -306,12 +323,23 @@ impl<const M: usize> Pipeline<M> {
             config.stance,
         ));
         let rest_delay = rest.delay() + filter.delay();
-        let delay = stance.delay() + filter.delay();
+        let cycle = CycleConfig::new(
+            config.rate,
+            config.accel,
+            config.gyro,
+            config.phases,
+            config.sensor_height_um,
+        );
+        let delay = match config.detector {
+            Detector::Cycle => cycle.delay(),
+            _ => stance.delay() + filter.delay(),
+        };
         Pipeline {
             filter,
             rest,
-            frame: FootFrameEstimator::new(config.rate, config.accel),
+            frame: FootFrameEstimator::new(config.rate, config.accel, config.gyro),
             segmenter: match config.detector {
+                Detector::Cycle => Segmenter::Cycle(CycleDetector::new(cycle)),
                 Detector::Stance => Segmenter::Stance {
                     stance,
                     tracker: StrideTracker::sized(config.rate, config.gyro, config.phases),
@@ -319,6 +347,7 @@ impl<const M: usize> Pipeline<M> {
                 Detector::PeakValley => Segmenter::PeakValley(PeakValleyDetector::new(config.rate)),
             },
             rate: config.rate,
+            accel_lsb_per_g: config.accel.lsb_per_g() as i32,
             model: config.model,
             settings: config.settings,
             params: config.params,
@@ -383,6 +412,25 @@ impl<const M: usize> Pipeline<M> {
     /// (zero until the clip has been still once).
     pub const fn gyro_bias(&self) -> [i32; 3] {
         self.frame.gyro_bias()
+    }
+
+    /// What the cycle detector judges the newest decision with: gyro bias and gravity from
+    /// the steadiest still blocks ([`crate::foot_frame::FootFrameEstimator::still_calibration`]),
+    /// or the foot frame's rest before the first block qualifies, and the foot's standing up.
+    /// `None` before the foot frame exists. After [`Pipeline::process`] it is what the
+    /// decision about sample `next_index() − 1 − latency()` used (the host's f64 twin
+    /// replays strides with it).
+    pub fn cycle_calibration(&self) -> Option<Calibration> {
+        let frame = self.frame.frame()?;
+        let (gyro_bias, gravity_counts) = self.frame.still_calibration().unwrap_or((
+            self.frame.gyro_bias(),
+            frame.gravity() * self.accel_lsb_per_g / FOOT_LSB_PER_G,
+        ));
+        Some(Calibration {
+            gyro_bias,
+            gravity_counts,
+            up: frame.up_row(),
+        })
     }
 
     /// Feeds one sample; returns a stride when one can be reported. After a hole that
@@ -474,6 +522,7 @@ impl<const M: usize> Pipeline<M> {
     /// strides, and once they are gone.
     pub fn stats(&self, stride: &Stride) -> Option<&StrideStats> {
         match &self.segmenter {
+            Segmenter::Cycle(c) => c.stats(stride.index),
             Segmenter::Stance { tracker, .. } => tracker.stats(stride.index),
             Segmenter::PeakValley(_) => None,
         }
@@ -512,7 +561,29 @@ impl<const M: usize> Pipeline<M> {
             return;
         };
         let foot = frame.apply(filtered);
+        let cal = match self.segmenter {
+            Segmenter::Cycle(_) => self.cycle_calibration(),
+            _ => None,
+        };
         let (stance, tracker) = match &mut self.segmenter {
+            Segmenter::Cycle(cycle) => {
+                self.foot_line[slot(index)] = foot;
+                self.stance_fed = self.stance_fed.saturating_add(1);
+                if self.since_reset <= self.delay + self.filter.delay() {
+                    return;
+                }
+                // The decision is about the sample `delay` back; its mean-filtered foot-frame
+                // value was computed `filter delay` inputs after it.
+                let at = index.wrapping_sub(self.delay);
+                let foot_at = at.wrapping_add(self.filter.delay());
+                let (raw, foot) = (self.raw_line[slot(at)], self.foot_line[slot(foot_at)]);
+                let origin = origin_of(self.bridged_line, self.filled_line, at);
+                let Some(cal) = cal else {
+                    return;
+                };
+                cycle.process_into(s, at, &raw, foot, origin, &cal, &mut out.stride);
+                return;
+            }
             Segmenter::Stance { stance, tracker } => (stance, tracker),
             Segmenter::PeakValley(peaks) => {
                 // The filtered value is the mean of a window centred `delay` samples back.
@@ -672,6 +743,10 @@ impl<const M: usize> Pipeline<M> {
         // later one stays held (reported after the gap), so nothing is lost.
         let drained = self.drain();
         let out = match &mut self.segmenter {
+            Segmenter::Cycle(cycle) => {
+                cycle.gap();
+                drained
+            }
             Segmenter::Stance { stance, tracker } => {
                 stance.reset();
                 match (drained, tracker.gap()) {
@@ -717,6 +792,13 @@ impl<const M: usize> Pipeline<M> {
                 self.holes.restarted_samples.saturating_add(hole.missing);
         }
         let drained = self.drain();
+        if let Segmenter::Cycle(cycle) = &mut self.segmenter {
+            let mut last = None;
+            cycle.finish(&mut last);
+            self.since_reset = 0;
+            self.stance_fed = 0;
+            return [last.map(|s| self.measured(s)), None];
+        }
         let Segmenter::Stance { tracker, .. } = &mut self.segmenter else {
             return match flushed_step {
                 Some(s) => [Some(self.measure_step(s)), self.take()],
@@ -739,7 +821,7 @@ impl<const M: usize> Pipeline<M> {
     /// steps its look-ahead was waiting on (up to half its [`crate::peak_valley::EXTREMES_CAPACITY`]).
     pub fn take(&mut self) -> Option<Stride> {
         match &mut self.segmenter {
-            Segmenter::Stance { .. } => None,
+            Segmenter::Cycle(_) | Segmenter::Stance { .. } => None,
             Segmenter::PeakValley(peaks) => {
                 let step = peaks.finish();
                 step.map(|s| self.measure_step(s))
@@ -789,6 +871,7 @@ impl<const M: usize> Pipeline<M> {
             heel_off: step.peak.index,
             toe_off: step.peak.index,
             heel_strike: step.valley.index,
+            foot_flat: step.valley.index,
             end: step.valley.index,
             flags: StrideFlags(flags),
             ..Stride::default()

@@ -152,6 +152,8 @@ pub struct RestSums {
     pub accel: [i64; 3],
     /// Σ gyroscope counts per axis.
     pub gyro: [i64; 3],
+    /// Σ |gyro|² (counts², all axes), for the rate's spread about its mean.
+    pub gyro_sq: u64,
     /// Samples summed (after halvings).
     pub count: u32,
 }
@@ -165,6 +167,7 @@ impl RestSums {
         RestSums {
             accel: [0; 3],
             gyro: [0; 3],
+            gyro_sq: 0,
             count: 0,
         }
     }
@@ -174,8 +177,15 @@ impl RestSums {
         if self.count >= Self::HALVING_AT {
             self.accel = self.accel.map(|v| v / 2);
             self.gyro = self.gyro.map(|v| v / 2);
+            self.gyro_sq /= 2;
             self.count /= 2;
         }
+        self.gyro_sq = self.gyro_sq.saturating_add(
+            s.gyro
+                .iter()
+                .map(|&g| (g as i64 * g as i64) as u64)
+                .sum::<u64>(),
+        );
         for ((a, g), (&sa, &sg)) in self
             .accel
             .iter_mut()
@@ -186,5 +196,16 @@ impl RestSums {
             *g += sg as i64;
         }
         self.count += 1;
+    }
+
+    /// The angular rate's variance about its mean, counts² (all axes together).
+    pub fn gyro_variance(&self) -> u64 {
+        if self.count == 0 {
+            return 0;
+        }
+        let n = self.count as i128;
+        let sq = self.gyro_sq as i128 * n;
+        let mean2: i128 = self.gyro.iter().map(|&g| g as i128 * g as i128).sum();
+        ((sq - mean2).max(0) / (n * n)) as u64
     }
 }

@@ -69,6 +69,15 @@ impl GyroRange {
         }
     }
 
+    /// An angular rate in mrad/s as counts of this range, rounded (exact to ±0.5 count
+    /// plus 1 ppm for π; any `mrad_per_s` up to 10⁶, 1 000 rad/s).
+    pub const fn counts_of_mrad_per_s(self, mrad_per_s: u32) -> u32 {
+        // counts = mrad/1000 · (180/π) · lsb10/10, π as 3 141 593 / 10⁶.
+        let num = mrad_per_s as u64 * self.lsb_per_dps_x10() as u64 * 180 * 1_000_000;
+        let den = 3_141_593u64 * 10_000;
+        ((num + den / 2) / den) as u32
+    }
+
     /// The range for an `FS_SEL` field value; `None` above 3.
     pub const fn from_fs_sel(v: u8) -> Option<Self> {
         match v {
@@ -140,6 +149,16 @@ impl RawSample {
             i += 1;
         }
         out
+    }
+
+    /// True if a gyroscope axis sits at a rail of its range.
+    pub const fn gyro_saturated(&self) -> bool {
+        rail(self.gyro[0]) || rail(self.gyro[1]) || rail(self.gyro[2])
+    }
+
+    /// True if an accelerometer axis sits at a rail of its range.
+    pub const fn accel_saturated(&self) -> bool {
+        rail(self.accel[0]) || rail(self.accel[1]) || rail(self.accel[2])
     }
 
     /// True if any axis sits at a rail of its range (the true value may be beyond it).

@@ -66,7 +66,10 @@ pub const MAX_STRIDE_MM: u32 = 6000;
 pub struct StrideFlags(pub u16);
 
 impl StrideFlags {
-    /// A sample of the movement sat at a rail of its range: the length is uncertain.
+    /// A sample of the movement sat at a rail of its range and the length could not be
+    /// restored: uncertain. The cycle detector ([`crate::cycle`]) sets it for the
+    /// accelerometer's rails (a gyro at a rail is [`StrideFlags::GYRO_CLIPPED`] there), the
+    /// stance detector for any rail.
     pub const SATURATED: u16 = 1 << 0;
     /// The movement overflowed the movement buffer: not a walking stride.
     pub const TOO_LONG: u16 = 1 << 1;
@@ -92,6 +95,11 @@ impl StrideFlags {
     /// longer one inside the stance) was bridged by interpolation: the stride and its
     /// length stay valid (informational).
     pub const BRIDGED: u16 = 1 << 8;
+    /// The gyroscope sat at a rail in the movement; the tilt the clipped rates lost was
+    /// restored from the end stance's gravity
+    /// ([`crate::zupt::ZuptIntegrator::displacement_restoring_tilt`]): the length stays
+    /// valid (informational).
+    pub const GYRO_CLIPPED: u16 = 1 << 9;
     /// Flags that make a length untrustworthy.
     pub const INVALID: u16 = Self::SATURATED | Self::TOO_LONG | Self::GAP | Self::IMPLAUSIBLE;
 
@@ -119,7 +127,11 @@ pub struct Stride {
     pub toe_off: u32,
     /// Heel-strike: swing ends.
     pub heel_strike: u32,
-    /// Foot-flat ending the stride (the next stride's start); exclusive end.
+    /// Foot-flat: the movement ends, the next stance begins (for the stance detector, the
+    /// same as `end`).
+    pub foot_flat: u32,
+    /// The stride's exclusive end, the next stride's start: the next foot-flat (stance
+    /// detector) or the next stance instant (cycle detector).
     pub end: u32,
     /// Length of the stride, mm, from the pipeline's length model
     /// ([`crate::models`]); 0 until the pipeline sets it.
@@ -315,6 +327,7 @@ impl<const M: usize> StrideTracker<M> {
             heel_off: self.heel_off,
             toe_off: self.gap_at,
             heel_strike: self.gap_at,
+            foot_flat: end,
             end,
             flags: StrideFlags(flags),
             ..Stride::default()
@@ -566,6 +579,7 @@ impl<const M: usize> StrideTracker<M> {
             heel_off: self.heel_off,
             toe_off,
             heel_strike,
+            foot_flat,
             end: foot_flat,
             length_mm: 0,
             zupt_um: d.horizontal_um.min(u32::MAX as u64) as u32,
@@ -583,7 +597,7 @@ impl<const M: usize> StrideTracker<M> {
 
 /// `|f| − g` of a foot-frame sample `[forward, left, up − g]` (g/2048), in g/2048,
 /// saturated to `i16`: the orientation-free magnitude channel of [`crate::phase_stats`].
-fn magnitude_minus_g(foot: [i16; 3]) -> i16 {
+pub(crate) fn magnitude_minus_g(foot: [i16; 3]) -> i16 {
     let up = foot[2] as i64 + FOOT_LSB_PER_G as i64;
     let m2 = (foot[0] as i64).pow(2) + (foot[1] as i64).pow(2) + up * up;
     let m = isqrt_u64(m2 as u64) as i64 - FOOT_LSB_PER_G as i64;

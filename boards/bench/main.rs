@@ -2,8 +2,8 @@
 //! whose instructions `gaitclip cost` counts in a function of its own, called with `bl`:
 //!
 //! * [`bench_sample`]: one sample from its 14 register bytes through [`Pipeline::process`].
-//!   Inside it, the per-stride work runs in `StrideTracker::close` (phases, phase statistics,
-//!   ZUPT displacement) and `Pipeline::measure` (features and the default model), which
+//!   Inside it, the per-stride work runs in `CycleDetector::close` (phases, phase statistics,
+//!   the ZUPT displacement with its tilt restored) and `Pipeline::measure` (features and the default model), which
 //!   the counting plugin measures apart, so the per-sample figure is the sample path alone.
 //! * [`bench_features`] and [`bench_model`]: the features of each stride and every model this
 //!   build carries, one call each, in [`Model::ALL`] order (printed at the end).
@@ -93,7 +93,7 @@ fn main() -> ! {
         totals.distance_mm
     );
     // The order of the `bench_model` calls of each stride.
-    if CONFIG.detector == Detector::Stance {
+    if CONFIG.detector != Detector::PeakValley {
         for model in Model::ALL.iter().filter(|m| CONFIG.params.ships(**m)) {
             defmt::println!("bench model={=str}", model.name());
         }
@@ -105,7 +105,7 @@ fn main() -> ! {
     }
 }
 
-/// Counts a stride and, with the stance detector, calls its features and every model.
+/// Counts a stride and, unless it is a peak-valley step, calls its features and every model.
 // Not inlined, nor is `drain`: their strides and features (≈ 1.3 KiB) would otherwise sit in
 // `main`'s frame under the whole sample path, and the M0's stack is ≈ 8 KiB.
 #[inline(never)]

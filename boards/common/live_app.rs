@@ -27,12 +27,13 @@ use crate::stride_log::StrideLog;
 /// Interval of the status line.
 pub const STATUS_EVERY_MS: u32 = 60_000;
 
-/// The firmware's step detector: stance to stance, unless the board is built with the
-/// `peak-valley-detector` feature (Lu's detection and chain; see `gaitclip::pipeline`).
+/// The firmware's step detector: one stance instant per gait cycle (the every-pace
+/// detector, `gaitclip::cycle`), unless the board is built with the `peak-valley-detector`
+/// feature (Lu's detection and chain; see `gaitclip::pipeline`).
 pub const DETECTOR: Detector = if cfg!(feature = "peak-valley-detector") {
     Detector::PeakValley
 } else {
-    Detector::Stance
+    Detector::Cycle
 };
 
 /// The pipeline's configuration for samples at `rate` in the given ranges, with the

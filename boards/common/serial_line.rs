@@ -17,7 +17,8 @@
 //! `index` counts strides from 0; `t_ms` is the start of the stride since power-up;
 //! `duration_ms` is the whole stride and the four phase columns add up to it; `flags` is
 //! the bit set of [`gaitclip::stride::StrideFlags`] (1 saturated, 2 too long, 4 from rest,
-//! 8 to rest, 16 turn, 32 phases guessed, 64 gap, 128 implausible, 256 bridged); `valid` is 0 when a flag
+//! 8 to rest, 16 turn, 32 phases guessed, 64 gap, 128 implausible, 256 bridged, 512 gyro
+//! clipped and restored); `valid` is 0 when a flag
 //! makes the length untrustworthy (a gap stride has length 0).
 //! `tests-host/tests/board_glue.rs` parses these lines back.
 

@@ -1,0 +1,823 @@
+//! The every-pace stance detector: one zero-velocity instant per gait cycle, from slow
+//! walking to running, and the stride between two of them measured by strapdown
+//! integration with the rolling foot's velocity imposed at both ends.
+//!
+//! **Why not a threshold.** A walking foot at rest reads almost nothing; a jogging foot never
+//! drops below ≈ 0.5–1 rad/s on the ground. No fixed threshold on a stance statistic serves
+//! both (Huang's [`crate::stance`] detector merges strides at speed; SHOE's own thresholds
+//! fail one pace or the other). What every pace shares is the shape of the cycle: each
+//! cycle's stillest moment lies far below the swings either side of it.
+//!
+//! **The energy.** Per sample, `e = |ω − b|² / σω² + (|f| − g)² / σa²` (angular rate minus
+//! the rest's gyro bias, specific force against the rest's gravity; σω = 1 rad/s,
+//! σa = 1 m/s²), averaged over a centred window of [`ENERGY_WINDOW_MS`]: a SHOE-type
+//! statistic, in Q16 of (rad/s)².
+//!
+//! **One instant per cycle.** After a stance, the energy rises into a swing. A sample is a
+//! *candidate* stance when the swing since the last stance has risen at least
+//! [`PROMINENCE_MILLIDECADES`] above it (and reached [`SWING_MIN_Q16`]: a step, not a
+//! fidget), the gyro's up, integrated from the last stance, agrees with the accelerometer's
+//! gravity within [`ATTITUDE_MAX_DEG`] (early in a swing the pitch rate crosses zero and
+//! looks like a stance for 20–30 ms: there the two differ by 60–90°), and gravity is within
+//! [`FLAT_MAX_DEG`] of the foot's standing up. The stillest candidate wins; it is confirmed
+//! once the energy after it has risen by the prominence again (the next push-off) and
+//! [`CONFIRM_MS`] have passed without a candidate [`SUPERSEDE_MILLIDECADES`] deeper (a slow
+//! swing dips in the middle; the stance after it is far stiller). At rest (energy under
+//! [`REST_Q16`]) a later instant is as good as a stiller one: the stance instant follows the
+//! rest, and a stance that lasts [`MAX_STANCE_MS`] ends the stride before it (the last step
+//! before standing).
+//!
+//! **The stride.** A strapdown integrator ([`ZuptIntegrator`]) starts at each candidate:
+//! levelled from the mean specific force of the stance so far (the stretch where the energy
+//! lies the prominence below the swing), gyro bias and gravity from the last rest, and the
+//! velocity of a sensor [`SENSOR_HEIGHT_UM`] above the foot's rolling contact
+//! ([`RollingContact`]): the foot rolls at its stillest instant, and imposing zero there
+//! makes strides short, the more so the faster. At the next confirmed instant the same
+//! velocity is imposed at the end, the difference removed as linear drift. Per stride, no
+//! state carries over but the rest's calibration.
+//!
+//! **The record.** A stride runs from one stance instant to the next (mid-stance to
+//! mid-stance); its movement from heel-off (the energy [`EDGE_MILLIDECADES`] above the
+//! instant's) to foot-flat (the energy back under the swing by the prominence), where
+//! Huang's phase splitter finds toe-off and heel-strike and the phase statistics are taken.
+//!
+//! Streaming, integer and bounded: a ring of [`ENERGY_CAPACITY`] energies, three
+//! integrators (the stride, its state at the candidate, the next stride's from the
+//! candidate), and the movement buffer of the stride tracker.
+
+use heapless::Vec;
+
+use crate::fixed::{isqrt_u64, QuatQ30};
+use crate::phase_stats::{StrideStats, CHANNELS};
+use crate::phases::{self, PhaseMethod};
+use crate::rate::SampleRate;
+use crate::sample::{AccelRange, GyroRange, RawSample};
+use crate::stride::{magnitude_minus_g, Origin, Stride, StrideFlags, MAX_STANCE_IN_STRIDE_MS};
+use crate::zupt::{RollingContact, ZuptIntegrator};
+
+/// Energy window, ms (5 samples at 100 Hz, as SHOE's; 11 at 200 Hz).
+pub const ENERGY_WINDOW_MS: u32 = 50;
+/// Ring capacity of the energies: a power of two above the window at 1 kHz (51).
+pub const ENERGY_CAPACITY: usize = 64;
+/// σω of the energy, mrad/s.
+pub const SIGMA_W_MRADPS: u32 = 1000;
+/// σa of the energy, mm/s².
+pub const SIGMA_A_MMPS2: u32 = 1000;
+/// A stance lies at least this far below the swing either side, millidecades (1.25 decades,
+/// × 17.8).
+pub const PROMINENCE_MILLIDECADES: u32 = 1250;
+/// A confirmed candidate gives way to one at least this much deeper, millidecades (× 10).
+pub const SUPERSEDE_MILLIDECADES: u32 = 1000;
+/// Heel-off: the energy this far above the stance instant's, millidecades (× 3.2).
+pub const EDGE_MILLIDECADES: u32 = 500;
+/// A candidate is confirmed this long after it, ms.
+pub const CONFIRM_MS: u32 = 500;
+/// Stances at least this far apart, ms.
+pub const MIN_SPACING_MS: u32 = 300;
+/// A swing reaches at least this energy, Q16 of (rad/s)² (1 (rad/s)²: a step, not a fidget).
+pub const SWING_MIN_Q16: u64 = 1 << 16;
+/// At rest the energy is under this, Q16 of (rad/s)² (0.01 (rad/s)², ≈ 6 °/s).
+pub const REST_Q16: u64 = 655;
+/// Gyro's up against the accelerometer's gravity at a stance, at most, degrees.
+pub const ATTITUDE_MAX_DEG: u32 = 45;
+/// Gravity against the foot's standing up at a stance, at most, degrees.
+pub const FLAT_MAX_DEG: u32 = 60;
+/// The sensor's height above the foot's rolling contact, µm. A clip on the side of the shoe
+/// sits ≈ 4–6 cm above it, one on the laces ≈ 8–10 cm; measured: see the README.
+pub const SENSOR_HEIGHT_UM: u32 = 80_000;
+
+/// cos²(45°) and cos²(60°) in Q30.
+const COS2_45_Q30: i128 = 1 << 29;
+const COS2_60_Q30: i128 = 1 << 28;
+
+/// `10^(millidecades/1000)` as a ratio `num/den` (to 0.01 %), for the three constants above.
+const fn ratio(millidecades: u32) -> (u64, u64) {
+    match millidecades {
+        1250 => (177_828, 10_000),
+        1000 => (100_000, 10_000),
+        500 => (31_623, 10_000),
+        _ => (10_000, 10_000),
+    }
+}
+
+/// The detector's constants at one rate and range.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct CycleConfig {
+    /// Half the energy window, samples (the window is 2·half + 1).
+    pub half: u32,
+    /// Samples of [`CONFIRM_MS`], [`MIN_SPACING_MS`], [`MAX_STANCE_IN_STRIDE_MS`].
+    pub confirm: u32,
+    /// See [`MIN_SPACING_MS`].
+    pub spacing: u32,
+    /// See [`MAX_STANCE_IN_STRIDE_MS`].
+    pub max_stance: u32,
+    /// Gyro counts² → Q40 of (rad/s)²/σω².
+    k_w: u64,
+    /// Accelerometer counts² → Q40 of (m/s²)²/σa².
+    k_a: u64,
+    /// The rolling contact's velocity.
+    rolling: RollingContact,
+    /// Phase splitter.
+    pub phases: PhaseMethod,
+    merge: u32,
+    integrator: ZuptIntegrator,
+}
+
+impl CycleConfig {
+    /// The constants for `rate`, the ranges, Huang's splitter `phases` and a sensor
+    /// `sensor_height_um` above the foot's rolling contact ([`SENSOR_HEIGHT_UM`]).
+    pub const fn new(
+        rate: SampleRate,
+        accel: AccelRange,
+        gyro: GyroRange,
+        phases: PhaseMethod,
+        sensor_height_um: u32,
+    ) -> Self {
+        let w = rate.samples_in_ms(ENERGY_WINDOW_MS);
+        let mut half = w / 2;
+        if half < 1 {
+            half = 1;
+        }
+        if half as usize > (ENERGY_CAPACITY - 1) / 2 {
+            half = ((ENERGY_CAPACITY - 1) / 2) as u32;
+        }
+        // (rad/s per count)² = (π·10 / (180·lsb10))²; ÷ σω²; × 2⁴⁰.
+        let lsb10 = gyro.lsb_per_dps_x10() as u128;
+        let pi_q32 = 13_493_037_705u128;
+        let sw = SIGMA_W_MRADPS as u128;
+        // π²·100·10⁶ / (180²·lsb10²·σω²[mrad²]) · 2⁴⁰ = (π·2³²)²·100·10⁶·2⁴⁰ / (2⁶⁴·180²·lsb10²·σ²)
+        let k_w =
+            ((pi_q32 * pi_q32 * 100 * 1_000_000) / (180 * 180 * lsb10 * lsb10 * sw * sw)) >> 24;
+        // (m/s² per count)² = (9.80665 / lsb_g)²; ÷ σa²; × 2⁴⁰.
+        let lsb_g = accel.lsb_per_g() as u128;
+        let sa = SIGMA_A_MMPS2 as u128;
+        // 9806.65² mm²/s⁴ per g² → (9806.65 / (lsb·σa[mm]))² · 2⁴⁰, with 9806.65 = 980665/100.
+        let k_a = ((980_665u128 * 980_665u128) << 40) / (lsb_g * lsb_g * sa * sa * 10_000);
+        CycleConfig {
+            half,
+            confirm: rate.samples_in_ms(CONFIRM_MS),
+            spacing: rate.samples_in_ms(MIN_SPACING_MS),
+            max_stance: rate.samples_in_ms(MAX_STANCE_IN_STRIDE_MS),
+            k_w: k_w as u64,
+            k_a: k_a as u64,
+            rolling: RollingContact::new(sensor_height_um, rate, gyro),
+            phases,
+            merge: rate.samples_in_ms(phases::MERGE_MS),
+            integrator: ZuptIntegrator::new(rate, gyro),
+        }
+    }
+
+    /// Samples between the newest input and the sample a decision is about.
+    pub const fn delay(&self) -> u32 {
+        self.half
+    }
+
+    /// The energy of one sample, Q16 of (rad/s)² (saturated at 2²⁶, 1 024 (rad/s)²: a
+    /// swing's peak, far above any stance), for the rest's gyro bias and gravity (counts).
+    pub fn energy_q16(&self, s: &RawSample, bias: [i32; 3], gravity_counts: i32) -> u32 {
+        let w2: u64 = (0..3)
+            .map(|k| {
+                let d = s.gyro[k] as i64 - bias[k] as i64;
+                (d * d) as u64
+            })
+            .sum();
+        let a2: u64 = s.accel.iter().map(|&a| (a as i64 * a as i64) as u64).sum();
+        let d = isqrt_u64(a2) as i64 - gravity_counts as i64;
+        let e = (w2 as u128 * self.k_w as u128 + (d * d) as u128 * self.k_a as u128) >> 24;
+        e.min(1 << 26) as u32
+    }
+}
+
+/// Calibration from the last rest, which the detector needs before it runs.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Calibration {
+    /// Gyro bias, counts.
+    pub gyro_bias: [i32; 3],
+    /// Gravity magnitude, accelerometer counts.
+    pub gravity_counts: i32,
+    /// The foot's standing up, any scale, sensor axes (counts of the rest's mean force).
+    pub up: [i32; 3],
+}
+
+/// The candidate stance.
+#[derive(Clone, Copy, Debug)]
+struct Candidate {
+    index: u32,
+    /// Energy (window sum).
+    energy: u64,
+    /// The stride's integrator at the candidate.
+    snap: ZuptIntegrator,
+    /// Gyro minus bias at the candidate (for the rolling velocity there).
+    omega: [i32; 3],
+    /// The accelerometer's gravity over the stance so far (sensor axes, counts·2⁸).
+    gravity: [i64; 3],
+    /// The energy after it has risen by the prominence.
+    risen: bool,
+    /// First sample of the low stretch it lies in: the movement's foot-flat.
+    foot_flat: u32,
+    /// The movement's length in the buffer up to the foot-flat.
+    movement_len: usize,
+    /// The movement's length in samples up to the foot-flat (more than the buffer holds:
+    /// too long).
+    movement_needed: u32,
+    /// The next movement's heel-off, once the energy rose after the candidate, and where
+    /// its samples start in the buffer.
+    next_heel_off: Option<u32>,
+    tail_pos: usize,
+    /// The stride's flags up to it.
+    flags: u16,
+    /// The low stretch has lasted longer than a stance in a stride.
+    long_stance: bool,
+}
+
+/// The stride in progress: from a confirmed stance instant.
+#[derive(Clone, Copy, Debug)]
+struct Current {
+    start: u32,
+    /// Energy at the instant.
+    energy: u64,
+    integrator: ZuptIntegrator,
+    heel_off: Option<u32>,
+    flags: u16,
+    /// Samples were lost and detection restarted inside it.
+    broken: bool,
+}
+
+/// The every-pace stance detector and its strides, keeping at most `M` samples of a
+/// movement.
+#[derive(Clone, Debug)]
+pub struct CycleDetector<const M: usize> {
+    cfg: CycleConfig,
+    ring: [u32; ENERGY_CAPACITY],
+    /// Σ of the window's energies.
+    sum: u64,
+    /// Inputs since the start or a gap.
+    seen: u32,
+    cur: Option<Current>,
+    cand: Option<Candidate>,
+    /// The integrator started at the candidate.
+    next: ZuptIntegrator,
+    /// Largest energy since the stance instant (or since the candidate, once there is one).
+    peak: u64,
+    peak_since_cand: u64,
+    /// Σ f and count over the current low stretch, and where it began.
+    low_sum: [i64; 3],
+    low_n: u32,
+    low_start: u32,
+    in_low: bool,
+    /// Movement buffer: `[vertical, sagittal, |f| − g]` from the stride's heel-off
+    /// (`movement[0]` is sample `mv_origin`), less the samples of a slow swing's dip that
+    /// were taken for a stance (`mv_gap`: buffer position and samples skipped there).
+    movement: Vec<[i16; CHANNELS], M>,
+    mv_origin: u32,
+    mv_gap: Option<(usize, u32)>,
+    /// The stance before the candidate was long (a rest).
+    from_rest: bool,
+    next_index: u32,
+    /// Phase statistics of the last two strides, by index parity.
+    stats: [(u32, StrideStats); 2],
+    dropped: u32,
+}
+
+/// The window sum's threshold for a per-sample energy in Q16.
+const fn per_window(q16: u64, w: u32) -> u64 {
+    q16 * w as u64
+}
+
+impl<const M: usize> CycleDetector<M> {
+    /// A detector with no history.
+    pub const fn new(cfg: CycleConfig) -> Self {
+        CycleDetector {
+            cfg,
+            ring: [0; ENERGY_CAPACITY],
+            sum: 0,
+            seen: 0,
+            cur: None,
+            cand: None,
+            next: cfg.integrator,
+            peak: 0,
+            peak_since_cand: 0,
+            low_sum: [0; 3],
+            low_n: 0,
+            low_start: 0,
+            in_low: false,
+            movement: Vec::new(),
+            mv_origin: 0,
+            mv_gap: None,
+            from_rest: false,
+            next_index: 0,
+            stats: [
+                (u32::MAX, StrideStats::EMPTY),
+                (u32::MAX, StrideStats::EMPTY),
+            ],
+            dropped: 0,
+        }
+    }
+
+    /// Samples between the newest input and the sample a decision is about.
+    pub const fn delay(&self) -> u32 {
+        self.cfg.half
+    }
+
+    /// The phase statistics of stride `index` while kept (see
+    /// [`crate::stride::StrideTracker::stats`]).
+    pub fn stats(&self, index: u32) -> Option<&StrideStats> {
+        let (at, stats) = &self.stats[(index & 1) as usize];
+        (*at == index).then_some(stats)
+    }
+
+    /// Strides that could not be reported (none by construction).
+    pub const fn dropped(&self) -> u32 {
+        self.dropped
+    }
+
+    const fn window(&self) -> u32 {
+        2 * self.cfg.half + 1
+    }
+
+    /// Samples were lost and detection restarts: the stride in progress is reported, at
+    /// the next stance, as a gap stride.
+    pub fn gap(&mut self) {
+        self.seen = 0;
+        self.sum = 0;
+        if let Some(c) = self.cur.as_mut() {
+            c.broken = true;
+        }
+        // A candidate not yet confirmed is dropped with the history it was judged on.
+        self.cand = None;
+        self.in_low = false;
+        self.low_n = 0;
+        self.low_sum = [0; 3];
+    }
+
+    /// Feeds the newest input `newest` (its energy enters the window) and the sample the
+    /// decision is about, [`CycleDetector::delay`] inputs back: its number `at`, raw values,
+    /// mean-filtered foot-frame acceleration `[forward, left, up − g]` (g/2048) and origin.
+    /// The stride it lets the detector report goes into `out` (if `out` is free).
+    #[allow(clippy::too_many_arguments)]
+    pub fn process_into(
+        &mut self,
+        newest: &RawSample,
+        at: u32,
+        s: &RawSample,
+        foot: [i16; 3],
+        origin: Origin,
+        cal: &Calibration,
+        out: &mut Option<Stride>,
+    ) {
+        let w = self.window();
+        let e = self
+            .cfg
+            .energy_q16(newest, cal.gyro_bias, cal.gravity_counts);
+        let slot = |i: u32| i as usize & (ENERGY_CAPACITY - 1);
+        let n = self.seen;
+        self.ring[slot(n)] = e;
+        self.sum += e as u64;
+        if n >= w {
+            self.sum -= self.ring[slot(n.wrapping_sub(w))] as u64;
+        }
+        self.seen = self.seen.saturating_add(1);
+        if self.seen < w {
+            return;
+        }
+        self.decide(at, self.sum, s, foot, origin, cal, out);
+    }
+
+    #[allow(clippy::too_many_arguments)]
+    fn decide(
+        &mut self,
+        i: u32,
+        t: u64,
+        s: &RawSample,
+        foot: [i16; 3],
+        origin: Origin,
+        cal: &Calibration,
+        out: &mut Option<Stride>,
+    ) {
+        // Not `let cfg = self.cfg`: the config holds an integrator, and this runs per sample.
+        let (confirm_after, max_stance) = (self.cfg.confirm, self.cfg.max_stance);
+        let w = self.window();
+        let (pn, pd) = ratio(PROMINENCE_MILLIDECADES);
+        let (sn, sd) = ratio(SUPERSEDE_MILLIDECADES);
+        let (en, ed) = ratio(EDGE_MILLIDECADES);
+        let rest = per_window(REST_Q16, w);
+        let swing_min = per_window(SWING_MIN_Q16, w);
+        let gravity_q8 = (cal.gravity_counts as i64) << 8;
+        let omega = [0, 1, 2].map(|k| s.gyro[k] as i32 - cal.gyro_bias[k]);
+
+        // The stride's integrator and the next one's take this sample.
+        let in_low = self.in_low;
+        if let Some(c) = self.cur.as_mut() {
+            if i != c.start {
+                c.integrator.process(s);
+            }
+            if s.accel_saturated() {
+                c.flags |= StrideFlags::SATURATED;
+            }
+            if s.gyro_saturated() {
+                c.flags |= StrideFlags::GYRO_CLIPPED;
+            }
+            mark(&mut c.flags, origin, c.heel_off.is_some() && !in_low);
+            // Heel-off: the energy first above the instant's (or the rest's) by the edge
+            // ratio.
+            if c.heel_off.is_none()
+                && self.cand.is_none()
+                && i != c.start
+                && t * ed >= c.energy.max(rest) * en
+            {
+                c.heel_off = Some(i);
+                self.movement.clear();
+                self.mv_origin = i;
+                self.mv_gap = None;
+            }
+        }
+        if let Some(c) = self.cand.as_mut() {
+            if i != c.index {
+                self.next.process(s);
+            }
+            // The next movement's heel-off: its samples go after the stride's movement.
+            if c.next_heel_off.is_none() && i != c.index && t * ed >= c.energy.max(rest) * en {
+                c.next_heel_off = Some(i);
+                self.movement.truncate(c.movement_len);
+                c.tail_pos = self.movement.len();
+            }
+        }
+        let moving = self.cur.as_ref().is_some_and(|c| c.heel_off.is_some());
+        if moving {
+            // Full: what is lost is counted when the stride closes (too long).
+            let _ = self
+                .movement
+                .push([foot[2], foot[0], magnitude_minus_g(foot)]);
+        }
+        self.peak = self.peak.max(t);
+        self.peak_since_cand = self.peak_since_cand.max(t);
+
+        // The low stretch: the energy the prominence under the swing, or at rest.
+        let low = t * pn <= self.peak * pd || t <= rest;
+        if low {
+            if !self.in_low {
+                self.in_low = true;
+                self.low_start = i;
+                self.low_sum = [0; 3];
+                self.low_n = 0;
+            }
+            if self.low_n >= 1 << 16 {
+                self.low_sum = self.low_sum.map(|v| v / 2);
+                self.low_n /= 2;
+            }
+            for k in 0..3 {
+                self.low_sum[k] += s.accel[k] as i64;
+            }
+            self.low_n += 1;
+        } else {
+            self.in_low = false;
+        }
+        let low_len = if self.in_low {
+            i.wrapping_sub(self.low_start)
+        } else {
+            0
+        };
+
+        // Confirmation of the candidate.
+        if let Some(c) = self.cand.as_mut() {
+            if t * pd >= c.energy.max(1) * pn {
+                c.risen = true;
+            }
+            let waited = i.wrapping_sub(c.index) >= confirm_after;
+            let rest_long = self.in_low && low_len > max_stance;
+            if (c.risen && waited) || rest_long {
+                c.long_stance |= rest_long;
+                self.confirm(out);
+                // The next stride starts at the candidate; the swing since it counts.
+                self.peak = self.peak_since_cand;
+                return;
+            }
+        }
+
+        // At rest with no stride under way: the stance instant follows the rest.
+        if self.in_low
+            && t <= rest
+            && self.cand.is_none()
+            && self.cur.is_some()
+            && self.peak < swing_min
+        {
+            let long = low_len > max_stance || self.from_rest;
+            self.from_rest = false;
+            let was = self
+                .cur
+                .as_ref()
+                .map_or(0, |c| c.flags & StrideFlags::FROM_REST);
+            self.restart_at(i, t, omega, cal, gravity_q8, long || was != 0);
+            return;
+        }
+
+        // A candidate.
+        if !self.in_low || self.low_n == 0 {
+            return;
+        }
+        let mean = self.low_sum.map(|v| (v << 8) / self.low_n as i64);
+        if !flat(&mean, &cal.up) {
+            return;
+        }
+        let first = self.cur.is_none();
+        if let Some(c) = self.cur.as_ref() {
+            if !agrees(&c.integrator.attitude(), &mean) {
+                return;
+            }
+        }
+        // The first stance: at rest, or (a recording that starts on the move, or whose
+        // first rest ended before the calibration came) after a swing, like any other.
+        let deep = self.peak >= swing_min || (first && t <= rest);
+        let better = match self.cand.as_ref() {
+            None => deep,
+            Some(c) if c.risen => t * sn <= c.energy * sd,
+            Some(c) => t < c.energy || (t <= rest && c.energy <= rest),
+        };
+        if !better {
+            return;
+        }
+        self.take_candidate(i, t, omega, mean, cal, gravity_q8);
+    }
+
+    /// Sample `i` (energy `t`, rate `omega`, the low stretch's gravity `mean`) becomes the
+    /// candidate: the next stride's integrator starts there and the stride's is kept as it
+    /// is now. Not inlined: its integrators (≈ 1 KiB) take stack only while it runs, never
+    /// under [`CycleDetector::confirm`]'s.
+    #[inline(never)]
+    fn take_candidate(
+        &mut self,
+        i: u32,
+        t: u64,
+        omega: [i32; 3],
+        mean: [i64; 3],
+        cal: &Calibration,
+        gravity_q8: i64,
+    ) {
+        let Some(level) = QuatQ30::level_from_up(mean) else {
+            return;
+        };
+        if gravity_q8 <= 0 {
+            return;
+        }
+        let v0 = self.cfg.rolling.velocity_q8(level, omega, gravity_q8);
+        // Where the stride's movement ends in the buffer: at this low stretch's start. A
+        // candidate that replaces one after the energy rose (a slow swing's dip) keeps the
+        // samples stored since that one's "heel-off" after the movement so far.
+        let ff = self.low_start;
+        let heel_off = self.cur.as_ref().and_then(|c| c.heel_off);
+        let (movement_len, needed) = match (heel_off, self.cand.as_ref()) {
+            (None, _) => (0, 0),
+            (Some(h), Some(old)) if old.next_heel_off.is_some() => {
+                let nh = old.next_heel_off.unwrap_or(h);
+                let skipped = nh.wrapping_sub(old.foot_flat);
+                let tail_pos = old.tail_pos;
+                if self.mv_gap.is_none() && skipped < u32::MAX / 2 {
+                    self.mv_gap = Some((tail_pos, skipped));
+                }
+                let len = tail_pos + ff.wrapping_sub(nh).min(M as u32) as usize;
+                (len.min(self.movement.len()), ff.wrapping_sub(h))
+            }
+            (Some(h), _) => {
+                let needed = ff.wrapping_sub(h);
+                let needed = if needed < u32::MAX / 2 { needed } else { 0 };
+                let skipped = self.mv_gap.map_or(0, |g| g.1);
+                (
+                    (needed.saturating_sub(skipped) as usize).min(self.movement.len()),
+                    needed,
+                )
+            }
+        };
+        // The next stride's integrator, started in place (an integrator is ≈ 300 B and the
+        // M0's stack is small); it cannot refuse a positive gravity.
+        self.next = self.cfg.integrator;
+        let _ = self.next.start_at(level, cal.gyro_bias, gravity_q8, v0);
+        let flags = self.cur.as_ref().map_or(0, |c| c.flags);
+        self.peak_since_cand = t;
+        self.cand = Some(Candidate {
+            index: i,
+            energy: t,
+            snap: match self.cur.as_ref() {
+                Some(c) => c.integrator,
+                None => self.next,
+            },
+            omega,
+            gravity: mean,
+            risen: false,
+            foot_flat: ff,
+            movement_len,
+            movement_needed: needed,
+            next_heel_off: None,
+            tail_pos: 0,
+            flags,
+            long_stance: false,
+        });
+    }
+
+    /// The stance instant moves to `i` (at rest, nothing under way); `from_rest` when the
+    /// rest has lasted longer than a stance in a stride. Not inlined, for its integrator.
+    #[inline(never)]
+    fn restart_at(
+        &mut self,
+        i: u32,
+        t: u64,
+        omega: [i32; 3],
+        cal: &Calibration,
+        gravity_q8: i64,
+        from_rest: bool,
+    ) {
+        let mean = self.low_sum.map(|v| (v << 8) / self.low_n.max(1) as i64);
+        let Some(level) = QuatQ30::level_from_up(mean) else {
+            return;
+        };
+        let v0 = self.cfg.rolling.velocity_q8(level, omega, gravity_q8);
+        let mut it = self.cfg.integrator;
+        if !it.start_at(level, cal.gyro_bias, gravity_q8, v0) {
+            return;
+        }
+        self.cur = Some(Current {
+            start: i,
+            energy: t,
+            integrator: it,
+            heel_off: None,
+            flags: if from_rest { StrideFlags::FROM_REST } else { 0 },
+            broken: false,
+        });
+        self.movement.clear();
+        self.mv_gap = None;
+        self.peak = t;
+    }
+
+    /// Confirms the candidate: closes the stride before it and starts the next from it. Not
+    /// inlined: the candidate and the stride it takes out (≈ 800 B) sit on the stack only
+    /// while it runs, not under every sample's decision.
+    #[inline(never)]
+    fn confirm(&mut self, out: &mut Option<Stride>) {
+        let Some(c) = self.cand.take() else {
+            return;
+        };
+        if let Some(cur) = self.cur.take() {
+            if c.index.wrapping_sub(cur.start) >= self.cfg.spacing {
+                let stride = self.close(&cur, &c);
+                match out {
+                    None => *out = Some(stride),
+                    Some(_) => self.dropped = self.dropped.saturating_add(1),
+                }
+            }
+        }
+        let from_rest = core::mem::take(&mut self.from_rest) || c.long_stance;
+        // The next movement, if it began, moves to the front of the buffer.
+        match c.next_heel_off {
+            Some(h) => {
+                let tail = c.tail_pos.min(self.movement.len());
+                let n = self.movement.len() - tail;
+                self.movement.copy_within(tail.., 0);
+                self.movement.truncate(n);
+                self.mv_origin = h;
+            }
+            None => self.movement.clear(),
+        }
+        self.mv_gap = None;
+        self.cur = Some(Current {
+            start: c.index,
+            energy: c.energy,
+            integrator: self.next,
+            heel_off: c.next_heel_off,
+            flags: if from_rest { StrideFlags::FROM_REST } else { 0 },
+            broken: false,
+        });
+    }
+
+    /// The sample number of buffer position `p` of the movement.
+    fn sample_of(&self, p: u32) -> u32 {
+        match self.mv_gap {
+            Some((at, skipped)) if p as usize >= at => {
+                self.mv_origin.wrapping_add(p).wrapping_add(skipped)
+            }
+            _ => self.mv_origin.wrapping_add(p),
+        }
+    }
+
+    /// The stride from `cur`'s instant to the candidate's. Not inlined: its temporaries
+    /// (the split, the statistics) take stack only while it runs.
+    #[inline(never)]
+    fn close(&mut self, cur: &Current, c: &Candidate) -> Stride {
+        let mut flags = c.flags;
+        if c.long_stance {
+            flags |= StrideFlags::TO_REST;
+        }
+        if cur.broken {
+            flags |= StrideFlags::GAP;
+        }
+        if c.movement_needed as usize > M {
+            flags |= StrideFlags::TOO_LONG;
+        }
+        let len = c.movement_len.min(self.movement.len());
+        let heel_off = cur.heel_off.unwrap_or(c.foot_flat);
+        let index = self.next_index;
+        self.next_index = self.next_index.wrapping_add(1);
+        // The statistics go straight into their slot (≈ 400 B, not through the stack).
+        let (toe_off, heel_strike, found) = {
+            let movement = &self.movement[..len];
+            let split = phases::split(movement, self.cfg.phases, self.cfg.merge);
+            let slot = &mut self.stats[(index & 1) as usize];
+            slot.0 = index;
+            slot.1 = StrideStats::measure(movement, split.toe_off, split.heel_strike);
+            (split.toe_off, split.heel_strike, split.found)
+        };
+        if !found {
+            flags |= StrideFlags::PHASES_GUESSED;
+        }
+        if c.snap.turned_over_45_deg() {
+            flags |= StrideFlags::TURN;
+        }
+        let v_end = self
+            .cfg
+            .rolling
+            .velocity_q8(c.snap.attitude(), c.omega, c.snap.gravity_q8());
+        let d = c.snap.displacement_restoring_tilt(v_end, c.gravity);
+        let (toe_off, heel_strike) = if cur.heel_off.is_some() {
+            (self.sample_of(toe_off), self.sample_of(heel_strike))
+        } else {
+            (heel_off, heel_off)
+        };
+        // Events in order whatever the buffer held.
+        let foot_flat = c.foot_flat;
+        let heel_strike = heel_strike.min(foot_flat).max(heel_off);
+        let toe_off = toe_off.min(heel_strike).max(heel_off);
+        let d_ok = !cur.broken;
+        Stride {
+            index,
+            start: cur.start,
+            heel_off: heel_off.min(foot_flat),
+            toe_off,
+            heel_strike,
+            foot_flat,
+            end: c.index,
+            length_mm: 0,
+            zupt_um: if d_ok {
+                d.horizontal_um.min(u32::MAX as u64) as u32
+            } else {
+                0
+            },
+            climb_mm: if d_ok {
+                ((d.vertical_um + 500).div_euclid(1000)).clamp(i32::MIN as i64, i32::MAX as i64)
+                    as i32
+            } else {
+                0
+            },
+            flags: StrideFlags(flags),
+        }
+    }
+
+    /// At the end of a recording: the candidate, if any, is the last stance (the stride
+    /// before it ends there, the last before rest).
+    pub fn finish(&mut self, out: &mut Option<Stride>) {
+        if let Some(c) = self.cand.as_mut() {
+            c.long_stance = true;
+            self.confirm(out);
+        }
+        self.cur = None;
+    }
+}
+
+/// An interpolated sample's flag for the stride: in the movement a filled one makes it a gap
+/// stride, anything else bridged.
+fn mark(flags: &mut u16, origin: Origin, moving: bool) {
+    match (origin, moving) {
+        (Origin::Measured, _) => {}
+        (Origin::Filled, true) => *flags |= StrideFlags::GAP,
+        _ => *flags |= StrideFlags::BRIDGED,
+    }
+}
+
+/// Gravity `mean` (counts·2⁸) within [`FLAT_MAX_DEG`] of the standing up `up`.
+fn flat(mean: &[i64; 3], up: &[i32; 3]) -> bool {
+    let dot: i128 = (0..3).map(|k| mean[k] as i128 * up[k] as i128).sum();
+    if dot <= 0 {
+        return false;
+    }
+    let m2: i128 = mean.iter().map(|&v| v as i128 * v as i128).sum();
+    let u2: i128 = up.iter().map(|&v| v as i128 * v as i128).sum();
+    // dot² ≥ cos²·|m|²·|u|² with cos² in Q30. |m| < 2²⁴ (counts·2⁸) and |u| < 2³²: dot <
+    // 2⁵⁶, dot² < 2¹¹², m2·u2 < 2¹¹² are exact in i128; only the product with cos² needs
+    // the 2³⁰ taken out first, which drops 30 of its 112 bits (a relative 2⁻⁸²).
+    let lhs = dot * dot;
+    let rhs = ((m2 * u2) >> 30) * COS2_60_Q30;
+    lhs >= rhs
+}
+
+/// The gyro's up (the level frame's +z seen through `q`) within [`ATTITUDE_MAX_DEG`] of the
+/// gravity `mean` (counts·2⁸).
+fn agrees(q: &QuatQ30, mean: &[i64; 3]) -> bool {
+    let r = q.matrix();
+    // Up in sensor axes is the third row (Q30, unit).
+    let dot: i128 = (0..3).map(|k| r[2][k] as i128 * mean[k] as i128).sum();
+    if dot <= 0 {
+        return false;
+    }
+    let m2: i128 = mean.iter().map(|&v| v as i128 * v as i128).sum();
+    // dot² ≥ cos²(45°)·|m|²·2⁶⁰ (the row is unit in Q30).
+    let lhs = (dot >> 30) * (dot >> 30);
+    let rhs = (m2 * COS2_45_Q30) >> 30;
+    lhs >= rhs
+}
