@@ -226,8 +226,16 @@ struct Candidate {
     tail_pos: usize,
     /// The stride's flags up to it.
     flags: u16,
+    /// The flags of the samples after it: the next stride's, once it is confirmed (or the
+    /// stride's own, should a later candidate replace it).
+    next_flags: u16,
     /// The low stretch has lasted longer than a stance in a stride.
     long_stance: bool,
+    /// Samples were lost after it, with the swing after it already risen: it is confirmed
+    /// at the next input, and the next stride (from it) is broken there (the hole's first
+    /// sample and its position in that stride's movement buffer).
+    confirm_now: bool,
+    next_broken: Option<(u32, usize)>,
 }
 
 /// The stride in progress: from a confirmed stance instant.
@@ -239,8 +247,9 @@ struct Current {
     integrator: ZuptIntegrator,
     heel_off: Option<u32>,
     flags: u16,
-    /// Samples were lost and detection restarted inside it.
-    broken: bool,
+    /// Samples were lost and detection restarted inside it: the first lost sample, and the
+    /// movement buffer's length then (what comes after it is after the hole).
+    broken: Option<(u32, usize)>,
 }
 
 /// The every-pace stance detector and its strides, keeping at most `M` samples of a
@@ -274,6 +283,8 @@ pub struct CycleDetector<const M: usize> {
     /// The stance before the candidate was long (a rest).
     from_rest: bool,
     next_index: u32,
+    /// The last sample decided on.
+    last_at: u32,
     /// Phase statistics of the last two strides, by index parity.
     stats: [(u32, StrideStats); 2],
     dropped: u32,
@@ -306,6 +317,7 @@ impl<const M: usize> CycleDetector<M> {
             mv_gap: None,
             from_rest: false,
             next_index: 0,
+            last_at: 0,
             stats: [
                 (u32::MAX, StrideStats::EMPTY),
                 (u32::MAX, StrideStats::EMPTY),
@@ -336,15 +348,34 @@ impl<const M: usize> CycleDetector<M> {
     }
 
     /// Samples were lost and detection restarts: the stride in progress is reported, at
-    /// the next stance, as a gap stride.
+    /// the next stance, as a gap stride. A candidate the swing after it has already risen
+    /// from is kept and confirmed at the next input (on the sample path's stack, not the
+    /// gap's), so that the hole costs only the stride it falls in, the one from that
+    /// candidate, rather than merging it with the one before; an unrisen candidate is
+    /// dropped with the history it was judged on.
     pub fn gap(&mut self) {
+        let hole_at = self.last_at.wrapping_add(1);
+        let keep = match self.cand.as_mut() {
+            Some(c) if c.risen => {
+                let pos = match c.next_heel_off {
+                    Some(_) => self.movement.len().saturating_sub(c.tail_pos),
+                    None => 0,
+                };
+                c.confirm_now = true;
+                c.next_broken = c.next_broken.or(Some((hole_at, pos)));
+                true
+            }
+            _ => false,
+        };
         self.seen = 0;
         self.sum = 0;
-        if let Some(c) = self.cur.as_mut() {
-            c.broken = true;
+        if !keep {
+            let hole = (hole_at, self.movement.len());
+            if let Some(c) = self.cur.as_mut() {
+                c.broken = c.broken.or(Some(hole));
+            }
+            self.cand = None;
         }
-        // A candidate not yet confirmed is dropped with the history it was judged on.
-        self.cand = None;
         self.in_low = false;
         self.low_n = 0;
         self.low_sum = [0; 3];
@@ -365,6 +396,10 @@ impl<const M: usize> CycleDetector<M> {
         cal: &Calibration,
         out: &mut Option<Stride>,
     ) {
+        if self.cand.as_ref().is_some_and(|c| c.confirm_now) {
+            self.confirm(out);
+            self.peak = self.peak_since_cand;
+        }
         let w = self.window();
         let e = self
             .cfg
@@ -394,6 +429,7 @@ impl<const M: usize> CycleDetector<M> {
         cal: &Calibration,
         out: &mut Option<Stride>,
     ) {
+        self.last_at = i;
         // Not `let cfg = self.cfg`: the config holds an integrator, and this runs per sample.
         let (confirm_after, max_stance) = (self.cfg.confirm, self.cfg.max_stance);
         let w = self.window();
@@ -411,13 +447,10 @@ impl<const M: usize> CycleDetector<M> {
             if i != c.start {
                 c.integrator.process(s);
             }
-            if s.accel_saturated() {
-                c.flags |= StrideFlags::SATURATED;
+            // After a candidate the samples are the next stride's (below).
+            if self.cand.is_none() {
+                mark(&mut c.flags, s, origin, c.heel_off.is_some() && !in_low);
             }
-            if s.gyro_saturated() {
-                c.flags |= StrideFlags::GYRO_CLIPPED;
-            }
-            mark(&mut c.flags, origin, c.heel_off.is_some() && !in_low);
             // Heel-off: the energy first above the instant's (or the rest's) by the edge
             // ratio.
             if c.heel_off.is_none()
@@ -434,6 +467,12 @@ impl<const M: usize> CycleDetector<M> {
         if let Some(c) = self.cand.as_mut() {
             if i != c.index {
                 self.next.process(s);
+                mark(
+                    &mut c.next_flags,
+                    s,
+                    origin,
+                    c.next_heel_off.is_some() && !in_low,
+                );
             }
             // The next movement's heel-off: its samples go after the stride's movement.
             if c.next_heel_off.is_none() && i != c.index && t * ed >= c.energy.max(rest) * en {
@@ -591,7 +630,10 @@ impl<const M: usize> CycleDetector<M> {
         // M0's stack is small); it cannot refuse a positive gravity.
         self.next = self.cfg.integrator;
         let _ = self.next.start_at(level, cal.gyro_bias, gravity_q8, v0);
-        let flags = self.cur.as_ref().map_or(0, |c| c.flags);
+        // The stride's flags: up to the first candidate, and since it (a candidate that
+        // replaces another extends the stride over the samples after that one).
+        let flags = self.cur.as_ref().map_or(0, |c| c.flags)
+            | self.cand.as_ref().map_or(0, |c| c.flags | c.next_flags);
         self.peak_since_cand = t;
         self.cand = Some(Candidate {
             index: i,
@@ -609,7 +651,10 @@ impl<const M: usize> CycleDetector<M> {
             next_heel_off: None,
             tail_pos: 0,
             flags,
+            next_flags: 0,
             long_stance: false,
+            confirm_now: false,
+            next_broken: None,
         });
     }
 
@@ -640,7 +685,7 @@ impl<const M: usize> CycleDetector<M> {
             integrator: it,
             heel_off: None,
             flags: if from_rest { StrideFlags::FROM_REST } else { 0 },
-            broken: false,
+            broken: None,
         });
         self.movement.clear();
         self.mv_gap = None;
@@ -652,23 +697,37 @@ impl<const M: usize> CycleDetector<M> {
     /// while it runs, not under every sample's decision.
     #[inline(never)]
     fn confirm(&mut self, out: &mut Option<Stride>) {
-        let Some(c) = self.cand.take() else {
+        let Some(c) = self.cand.as_ref() else {
             return;
         };
-        if let Some(cur) = self.cur.take() {
-            if c.index.wrapping_sub(cur.start) >= self.cfg.spacing {
-                let stride = self.close(&cur, &c);
+        let spaced = self
+            .cur
+            .as_ref()
+            .is_some_and(|cur| c.index.wrapping_sub(cur.start) >= self.cfg.spacing);
+        // What the next stride takes from the candidate, before it goes.
+        let (index, energy, next_heel_off, tail_pos, next_flags, long_stance) = (
+            c.index,
+            c.energy,
+            c.next_heel_off,
+            c.tail_pos,
+            c.next_flags,
+            c.long_stance,
+        );
+        let next_broken = c.next_broken;
+        if spaced {
+            if let Some(stride) = self.close() {
                 match out {
                     None => *out = Some(stride),
                     Some(_) => self.dropped = self.dropped.saturating_add(1),
                 }
             }
         }
-        let from_rest = core::mem::take(&mut self.from_rest) || c.long_stance;
+        self.cand = None;
+        let from_rest = core::mem::take(&mut self.from_rest) || long_stance;
         // The next movement, if it began, moves to the front of the buffer.
-        match c.next_heel_off {
+        match next_heel_off {
             Some(h) => {
-                let tail = c.tail_pos.min(self.movement.len());
+                let tail = tail_pos.min(self.movement.len());
                 let n = self.movement.len() - tail;
                 self.movement.copy_within(tail.., 0);
                 self.movement.truncate(n);
@@ -677,49 +736,71 @@ impl<const M: usize> CycleDetector<M> {
             None => self.movement.clear(),
         }
         self.mv_gap = None;
-        self.cur = Some(Current {
-            start: c.index,
-            energy: c.energy,
-            integrator: self.next,
-            heel_off: c.next_heel_off,
-            flags: if from_rest { StrideFlags::FROM_REST } else { 0 },
-            broken: false,
-        });
-    }
-
-    /// The sample number of buffer position `p` of the movement.
-    fn sample_of(&self, p: u32) -> u32 {
-        match self.mv_gap {
-            Some((at, skipped)) if p as usize >= at => {
-                self.mv_origin.wrapping_add(p).wrapping_add(skipped)
+        let flags = next_flags | if from_rest { StrideFlags::FROM_REST } else { 0 };
+        // In place: a `Current` is ≈ 300 B.
+        match self.cur.as_mut() {
+            Some(cur) => {
+                cur.start = index;
+                cur.energy = energy;
+                cur.integrator = self.next;
+                cur.heel_off = next_heel_off;
+                cur.flags = flags;
+                cur.broken = next_broken;
             }
-            _ => self.mv_origin.wrapping_add(p),
+            None => {
+                self.cur = Some(Current {
+                    start: index,
+                    energy,
+                    integrator: self.next,
+                    heel_off: next_heel_off,
+                    flags,
+                    broken: next_broken,
+                })
+            }
         }
     }
 
-    /// The stride from `cur`'s instant to the candidate's. Not inlined: its temporaries
-    /// (the split, the statistics) take stack only while it runs.
+    /// The stride from the current stride's instant to the candidate's (`None` without
+    /// both). Not inlined: its temporaries (the split, the statistics) take stack only
+    /// while it runs.
     #[inline(never)]
-    fn close(&mut self, cur: &Current, c: &Candidate) -> Stride {
+    fn close(&mut self) -> Option<Stride> {
+        // The stride and the candidate are read where they are (≈ 700 B), not moved out.
+        let CycleDetector {
+            cfg,
+            cur,
+            cand,
+            movement,
+            mv_origin,
+            mv_gap,
+            next_index,
+            stats,
+            ..
+        } = self;
+        let (Some(cur), Some(c)) = (cur.as_ref(), cand.as_ref()) else {
+            return None;
+        };
+        let (mv_origin, mv_gap) = (*mv_origin, *mv_gap);
+        let sample_of = |p: u32| sample_of(mv_origin, mv_gap, p);
         let mut flags = c.flags;
         if c.long_stance {
             flags |= StrideFlags::TO_REST;
         }
-        if cur.broken {
+        if cur.broken.is_some() {
             flags |= StrideFlags::GAP;
         }
         if c.movement_needed as usize > M {
             flags |= StrideFlags::TOO_LONG;
         }
-        let len = c.movement_len.min(self.movement.len());
+        let len = c.movement_len.min(movement.len());
         let heel_off = cur.heel_off.unwrap_or(c.foot_flat);
-        let index = self.next_index;
-        self.next_index = self.next_index.wrapping_add(1);
+        let index = *next_index;
+        *next_index = next_index.wrapping_add(1);
         // The statistics go straight into their slot (≈ 400 B, not through the stack).
         let (toe_off, heel_strike, found) = {
-            let movement = &self.movement[..len];
-            let split = phases::split(movement, self.cfg.phases, self.cfg.merge);
-            let slot = &mut self.stats[(index & 1) as usize];
+            let movement = &movement[..len];
+            let split = phases::split(movement, cfg.phases, cfg.merge);
+            let slot = &mut stats[(index & 1) as usize];
             slot.0 = index;
             slot.1 = StrideStats::measure(movement, split.toe_off, split.heel_strike);
             (split.toe_off, split.heel_strike, split.found)
@@ -730,22 +811,32 @@ impl<const M: usize> CycleDetector<M> {
         if c.snap.turned_over_45_deg() {
             flags |= StrideFlags::TURN;
         }
-        let v_end = self
-            .cfg
+        let v_end = cfg
             .rolling
             .velocity_q8(c.snap.attitude(), c.omega, c.snap.gravity_q8());
         let d = c.snap.displacement_restoring_tilt(v_end, c.gravity);
-        let (toe_off, heel_strike) = if cur.heel_off.is_some() {
-            (self.sample_of(toe_off), self.sample_of(heel_strike))
-        } else {
-            (heel_off, heel_off)
+        let (toe_off, heel_strike) = match (cur.heel_off, cur.broken) {
+            // Events found after the hole are set to it: the buffer does not count the
+            // samples lost in it, and the restart did not see them.
+            (Some(_), Some((hole, pos))) => {
+                let at = |p: u32| {
+                    if p as usize >= pos {
+                        hole
+                    } else {
+                        sample_of(p)
+                    }
+                };
+                (at(toe_off), at(heel_strike))
+            }
+            (Some(_), None) => (sample_of(toe_off), sample_of(heel_strike)),
+            (None, _) => (heel_off, heel_off),
         };
         // Events in order whatever the buffer held.
         let foot_flat = c.foot_flat;
         let heel_strike = heel_strike.min(foot_flat).max(heel_off);
         let toe_off = toe_off.min(heel_strike).max(heel_off);
-        let d_ok = !cur.broken;
-        Stride {
+        let d_ok = cur.broken.is_none();
+        Some(Stride {
             index,
             start: cur.start,
             heel_off: heel_off.min(foot_flat),
@@ -766,7 +857,7 @@ impl<const M: usize> CycleDetector<M> {
                 0
             },
             flags: StrideFlags(flags),
-        }
+        })
     }
 
     /// At the end of a recording: the candidate, if any, is the last stance (the stride
@@ -780,9 +871,24 @@ impl<const M: usize> CycleDetector<M> {
     }
 }
 
-/// An interpolated sample's flag for the stride: in the movement a filled one makes it a gap
-/// stride, anything else bridged.
-fn mark(flags: &mut u16, origin: Origin, moving: bool) {
+/// The sample number of buffer position `p` of a movement whose buffer starts at sample
+/// `origin` and skips `gap.1` samples at position `gap.0`.
+fn sample_of(origin: u32, gap: Option<(usize, u32)>, p: u32) -> u32 {
+    match gap {
+        Some((at, skipped)) if p as usize >= at => origin.wrapping_add(p).wrapping_add(skipped),
+        _ => origin.wrapping_add(p),
+    }
+}
+
+/// What a sample sets in its stride's flags: a rail of either sensor, and an interpolated
+/// sample (in the movement a filled one makes it a gap stride, anything else bridged).
+fn mark(flags: &mut u16, s: &RawSample, origin: Origin, moving: bool) {
+    if s.accel_saturated() {
+        *flags |= StrideFlags::SATURATED;
+    }
+    if s.gyro_saturated() {
+        *flags |= StrideFlags::GYRO_CLIPPED;
+    }
     match (origin, moving) {
         (Origin::Measured, _) => {}
         (Origin::Filled, true) => *flags |= StrideFlags::GAP,

@@ -3,7 +3,7 @@
 //! (`tests-host/tests/firmware_qemu.rs`) reads the same list to replay the same holes.
 
 /// Runs of samples lost, `(first sample, samples)`, in the demo walk's swings unless said:
-/// 5 ms, 15 ms in a stance, 10 ms and 30 ms (bridged), 60 ms (filled: a gap stride with its
+/// 5 ms, 15 ms in a stance, 10 ms (bridged), 30 ms and 60 ms (filled: a gap stride with its
 /// events) and 200 ms (detection restarts after it).
 pub const LOST: &[(u32, u32)] = &[
     (1240, 1),
