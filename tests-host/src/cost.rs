@@ -27,7 +27,7 @@ pub const MEASURED: [(&str, &str); 7] = [
     ("sample", "bench::bench_sample"),
     ("features", "bench::bench_features"),
     ("model", "bench::bench_model"),
-    ("close", "gaitclip::stride::StrideTracker<_>::close"),
+    ("close", "gaitclip::cycle::CycleDetector<_>::close"),
     ("measure", "gaitclip::pipeline::Pipeline<_>::measure"),
     ("split", "gaitclip::phases::split"),
     ("stats", "gaitclip::phase_stats::StrideStats::measure"),
@@ -137,7 +137,7 @@ pub struct InsnReport {
     pub sample: Stat,
     /// Everything per sample, the per-stride steps spread over the samples (mean only).
     pub sample_all_mean: f64,
-    /// `StrideTracker::close`: phases, phase statistics, ZUPT displacement.
+    /// `CycleDetector::close`: phases, phase statistics, ZUPT displacement.
     pub close: Stat,
     /// `phases::split` (inside close).
     pub split: Stat,
@@ -470,7 +470,7 @@ pub const BUILDS: [Build; 6] = [
         bin: "mps2-an386",
         target: "thumbv7em-none-eabihf",
         machine: Some(qemu::MACHINE_M4),
-        detector: Detector::Stance,
+        detector: Detector::Cycle,
     },
     Build {
         label: "mps2-an386 (QEMU, M4F), peak-valley detector",
@@ -486,7 +486,7 @@ pub const BUILDS: [Build; 6] = [
         bin: "microbit",
         target: "thumbv6m-none-eabi",
         machine: Some(qemu::MACHINE_M0),
-        detector: Detector::Stance,
+        detector: Detector::Cycle,
     },
     Build {
         label: "microbit (QEMU, M0), peak-valley detector",
@@ -502,7 +502,7 @@ pub const BUILDS: [Build; 6] = [
         bin: "nrf52840-dk",
         target: "thumbv7em-none-eabihf",
         machine: None,
-        detector: Detector::Stance,
+        detector: Detector::Cycle,
     },
     Build {
         label: "rp-pico (M0+)",
@@ -510,7 +510,7 @@ pub const BUILDS: [Build; 6] = [
         bin: "rp-pico",
         target: "thumbv6m-none-eabi",
         machine: None,
-        detector: Detector::Stance,
+        detector: Detector::Cycle,
     },
 ];
 
@@ -707,7 +707,7 @@ fn render(r: &Report) -> String {
     );
     let _ = writeln!(
         o,
-        "| · phases, statistics, ZUPT (`StrideTracker::close`) | {} | {} |",
+        "| · phases, statistics, ZUPT (`CycleDetector::close`) | {} | {} |",
         f(&m4.close),
         f(&m0.close)
     );

@@ -15,7 +15,13 @@
 //! greedily by overlap, one to one. Only detections overlapping the labelled part of a
 //! recording count (from the first to the last reference stride; `ipol_gait_events`: its
 //! walk bounds). Flagged references (first/last strides, turns, shuffles, U-turn steps) and
-//! the detections matched to them count neither as found nor as missed nor as extra.
+//! the detections matched to them or lying mostly (half their movement or more) inside one
+//! count neither as found nor as missed nor as extra (*not scored*); so do detections mostly
+//! inside `ipol_gait_events`' U-turn, whose steps are labelled only in part. A detection
+//! matched to nothing that `pyshoe_vicon`'s Vicon stance label shows to be a movement of the
+//! foot (moving over half of it or more: a shuffle, or a stride inside borders that merged
+//! two) is counted apart as an *unbordered movement*, not as extra: the stride borders of
+//! that dataset were drawn in part by an automatic detector.
 //!
 //! **Events.** Toe-off and heel-strike errors are detected minus reference, over clean
 //! matched strides, reported as the median and 95th percentile of their absolute value.
@@ -52,8 +58,13 @@ pub struct Detected {
     pub toe_off: u32,
     /// Heel-strike.
     pub heel_strike: u32,
-    /// Foot-flat (end).
+    /// Foot-flat: the movement's end.
+    pub foot_flat: u32,
+    /// The stride's end (the next stride's start).
     pub end: u32,
+    /// The movement overflowed the movement buffer ([`gaitclip::stride::StrideFlags::TOO_LONG`]):
+    /// strides merged.
+    pub too_long: bool,
 }
 
 impl From<&gaitclip::stride::Stride> for Detected {
@@ -63,7 +74,9 @@ impl From<&gaitclip::stride::Stride> for Detected {
             heel_off: s.heel_off,
             toe_off: s.toe_off,
             heel_strike: s.heel_strike,
+            foot_flat: s.foot_flat,
             end: s.end,
+            too_long: s.flags.0 & gaitclip::stride::StrideFlags::TOO_LONG != 0,
         }
     }
 }
@@ -77,7 +90,9 @@ impl Detected {
             heel_off: f(self.heel_off),
             toe_off: f(self.toe_off),
             heel_strike: f(self.heel_strike),
+            foot_flat: f(self.foot_flat),
             end: f(self.end),
+            too_long: self.too_long,
         }
     }
 }
@@ -153,6 +168,9 @@ pub struct Trial {
     pub span: (u32, u32),
     /// The same bounds as times, s, where the dataset gives them (they override the rows).
     pub span_s: Option<(f64, f64)>,
+    /// A part of the span whose steps are not labelled one by one, s (`ipol_gait_events`'
+    /// U-turn): detections lying mostly inside it are not scored.
+    pub unscored_s: Option<(f64, f64)>,
     /// Per-sample stance label, where the dataset has one.
     pub stance: Option<Vec<bool>>,
     /// The walker's height, m, where the dataset gives it.
@@ -272,6 +290,7 @@ fn load_strides(dir: &Path, name: &str) -> Result<Vec<Trial>> {
             span,
             span_s: None,
             stance,
+            unscored_s: None,
             height_m: None,
             distance_m: None,
         });
@@ -297,6 +316,7 @@ fn load_ipol(dir: &Path) -> Result<Vec<Trial>> {
                     index(&row, "walk_end_idx", &tpath)?,
                 ),
                 (number(&row, "walk_start_s")?, number(&row, "walk_end_s")?),
+                (number(&row, "uturn_start_s")?, number(&row, "uturn_end_s")?),
                 // Some subjects' heights are not given: left empty.
                 match field(&row, "height_m", &tpath)?.trim() {
                     "" => None,
@@ -353,7 +373,7 @@ fn load_ipol(dir: &Path) -> Result<Vec<Trial>> {
             references[k].prev_heel_strike = references[k - 1].heel_strike;
             references[k].times.prev_heel_strike_s = references[k - 1].times.heel_strike_s;
         }
-        let (span, span_s, height, distance) = *spans
+        let (span, span_s, uturn_s, height, distance) = *spans
             .get(&trial)
             .with_context(|| format!("{}: no trial {trial}", tpath.display()))?;
         trials.push(Trial {
@@ -363,6 +383,7 @@ fn load_ipol(dir: &Path) -> Result<Vec<Trial>> {
             // The rows are the left foot's: the right foot's file has its own holes.
             span,
             span_s: Some(span_s),
+            unscored_s: Some(uturn_s),
             stance: None,
             height_m: height,
             distance_m: Some(distance),
@@ -384,6 +405,14 @@ pub struct Tally {
     pub fp: usize,
     /// Clean references matched to nothing.
     pub fn_: usize,
+    /// Detections not scored, neither found nor extra: matched to a flagged reference or
+    /// lying mostly inside one, or inside a part not labelled step by step (a U-turn).
+    pub unscored: usize,
+    /// Detections matched to no reference that the dataset's own motion capture shows to be
+    /// a movement of the foot (`pyshoe_vicon`'s stance label says "moving" over at least half
+    /// of it): a movement the stride borders leave out (a shuffle, a merged stride), not a
+    /// false detection. Counted here, not as extra.
+    pub unbordered: usize,
     /// Toe-off errors, ms.
     pub toe_off_ms: Vec<f64>,
     /// Heel-strike errors, ms.
@@ -394,8 +423,13 @@ pub struct Tally {
     pub contact: PhaseTally,
     /// Stance samples: (tp, fp, fn).
     pub stance: Option<(u64, u64, u64)>,
+    /// Stance instants (stride starts) inside a labelled stance, and all of them.
+    pub instants: Option<(usize, usize)>,
     /// Detections overlapping the labelled span (Lu's `E`).
     pub detected: usize,
+    /// Detections flagged too long (a movement longer than the buffer: strides merged),
+    /// anywhere in the recordings.
+    pub too_long: usize,
     /// Reference strides, flagged ones included (Lu's `T`).
     pub references: usize,
     /// Per trial, Lu's eq. 13 step-count error `|E − T| / T`.
@@ -445,15 +479,22 @@ impl Tally {
         self.tp += o.tp;
         self.fp += o.fp;
         self.fn_ += o.fn_;
+        self.unscored += o.unscored;
+        self.unbordered += o.unbordered;
         self.toe_off_ms.extend_from_slice(&o.toe_off_ms);
         self.heel_strike_ms.extend_from_slice(&o.heel_strike_ms);
         self.swing.add(&o.swing);
         self.contact.add(&o.contact);
         self.detected += o.detected;
+        self.too_long += o.too_long;
         self.references += o.references;
         self.count_errors.extend_from_slice(&o.count_errors);
         self.stance = match (self.stance, o.stance) {
             (Some(a), Some(b)) => Some((a.0 + b.0, a.1 + b.1, a.2 + b.2)),
+            (a, b) => a.or(b),
+        };
+        self.instants = match (self.instants, o.instants) {
+            (Some(a), Some(b)) => Some((a.0 + b.0, a.1 + b.1)),
             (a, b) => a.or(b),
         };
     }
@@ -485,6 +526,11 @@ impl Tally {
     pub fn stance_f1(&self) -> Option<f64> {
         self.stance
             .map(|(tp, fp, fn_)| f1(tp as f64, fp as f64, fn_ as f64))
+    }
+
+    /// Share of the zero-velocity instants inside a labelled stance.
+    pub fn instants_in_stance(&self) -> Option<f64> {
+        self.instants.map(|(i, n)| ratio(i as f64, n as f64))
     }
 }
 
@@ -528,7 +574,7 @@ fn iou(a: (u32, u32), b: (u32, u32)) -> f64 {
 pub fn match_strides(det: &[Detected], refs: &[Reference]) -> Vec<(usize, usize)> {
     let mut cand = Vec::new();
     for (i, d) in det.iter().enumerate() {
-        let dm = (d.heel_off, d.end);
+        let dm = (d.heel_off, d.foot_flat);
         for (j, r) in refs.iter().enumerate() {
             let rm = (r.start, r.end);
             let ov = overlap(dm, rm);
@@ -582,18 +628,91 @@ impl Trial {
     }
 }
 
+/// What one detection counts as (see the module's *Matching*).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Scored {
+    /// Matched to the clean reference of this index.
+    Found(usize),
+    /// Not scored: matched to a flagged reference, mostly inside one, or in a U-turn.
+    Unscored,
+    /// A real movement the borders leave out ([`Tally::unbordered`]).
+    Unbordered,
+    /// A false detection.
+    Extra,
+}
+
+/// How each of `det` (one trial's detections, in sample numbers of `clock`) is scored
+/// against the trial's references `refs` (in the same numbers).
+pub fn classify(
+    trial: &Trial,
+    clock: &SampleClock,
+    det: &[Detected],
+    refs: &[Reference],
+) -> Vec<Scored> {
+    let mut out: Vec<Scored> = vec![Scored::Extra; det.len()];
+    for (i, j) in match_strides(det, refs) {
+        out[i] = if refs[j].flagged {
+            Scored::Unscored
+        } else {
+            Scored::Found(j)
+        };
+    }
+    // Mostly inside: at least half the detected movement.
+    let mostly_in = |d: &Detected, (a, b): (u32, u32)| {
+        2 * overlap((d.heel_off, d.foot_flat), (a, b)) >= d.foot_flat - d.heel_off
+    };
+    let uturn = trial
+        .unscored_s
+        .map(|(a, b)| (clock.number_at(a), clock.number_at(b)));
+    let unscored = |d: &Detected| {
+        uturn.is_some_and(|u| mostly_in(d, u))
+            || refs
+                .iter()
+                .any(|r| r.flagged && mostly_in(d, (r.start, r.end)))
+    };
+    let vicon_moving = |d: &Detected| {
+        trial.stance.as_ref().is_some_and(|label| {
+            let from = clock.row_of_number(d.heel_off) as usize;
+            let to = clock.row_of_number(d.foot_flat) as usize;
+            let moving = (from..to).filter(|&k| label.get(k) == Some(&false)).count();
+            to > from && 2 * moving >= to - from
+        })
+    };
+    for (d, c) in det.iter().zip(out.iter_mut()) {
+        if *c == Scored::Extra {
+            *c = if unscored(d) {
+                Scored::Unscored
+            } else if vicon_moving(d) {
+                Scored::Unbordered
+            } else {
+                Scored::Extra
+            };
+        }
+    }
+    out
+}
+
+/// The detections of `strides` that overlap the trial's labelled span.
+pub fn in_span(trial: &Trial, clock: &SampleClock, strides: &[Detected]) -> Vec<Detected> {
+    let span = trial.span_in_numbers(clock);
+    strides
+        .iter()
+        .copied()
+        .filter(|d| overlap((d.heel_off, d.foot_flat), span) > 0)
+        .collect()
+}
+
 /// Scores one trial's detections.
 pub fn score(trial: &Trial, run: &Detections) -> Tally {
     let clock = &run.clock;
-    let span = trial.span_in_numbers(clock);
-    let in_span = |d: &Detected| overlap((d.heel_off, d.end), span) > 0;
-    let det: Vec<Detected> = run.strides.iter().copied().filter(in_span).collect();
+    let det = in_span(trial, clock, &run.strides);
     let refs = &trial.references_in_numbers(clock);
-    let pairs = match_strides(&det, refs);
+    let scored = classify(trial, clock, &det, refs);
     let mut t = Tally {
         trials: 1,
         clean: refs.iter().filter(|r| !r.flagged).count(),
         detected: det.len(),
+        too_long: run.strides.iter().filter(|d| d.too_long).count(),
         references: refs.len(),
         count_errors: vec![ratio(
             (det.len() as f64 - refs.len() as f64).abs(),
@@ -601,10 +720,6 @@ pub fn score(trial: &Trial, run: &Detections) -> Tally {
         )],
         ..Tally::default()
     };
-    let mut matched_d = vec![None; det.len()];
-    for &(i, j) in &pairs {
-        matched_d[i] = Some(j);
-    }
     let ms = |samples: f64| samples * 1000.0 * clock.period_s;
     t.swing.labelled = refs.iter().any(|r| r.toe_off.is_some());
     t.contact.labelled = refs.iter().any(|r| r.prev_heel_strike.is_some());
@@ -613,9 +728,11 @@ pub fn score(trial: &Trial, run: &Detections) -> Tally {
             .checked_sub(1)
             .map(|k| det[k])
             .filter(|p| p.end == d.start);
-        match matched_d[i].map(|j| (j, refs[j])) {
-            Some((_, r)) if r.flagged => {}
-            Some((_, r)) => {
+        match scored[i] {
+            Scored::Unscored => t.unscored += 1,
+            Scored::Unbordered => t.unbordered += 1,
+            Scored::Found(j) => {
+                let r = refs[j];
                 t.tp += 1;
                 if let (Some(to), Some(hs)) = (r.toe_off, r.heel_strike) {
                     t.toe_off_ms.push(ms(d.toe_off as f64 - to as f64));
@@ -628,7 +745,7 @@ pub fn score(trial: &Trial, run: &Detections) -> Tally {
                     phase(&mut t.contact, v);
                 }
             }
-            None => {
+            Scored::Extra => {
                 t.fp += 1;
                 t.swing.fp += t.swing.labelled as usize;
                 t.contact.fp += (t.contact.labelled && prev.is_some()) as usize;
@@ -660,7 +777,7 @@ pub fn score(trial: &Trial, run: &Detections) -> Tally {
         for d in &det {
             for m in moving
                 .iter_mut()
-                .take(d.end as usize)
+                .take(d.foot_flat as usize)
                 .skip(d.heel_off as usize)
             {
                 *m = true;
@@ -679,6 +796,15 @@ pub fn score(trial: &Trial, run: &Detections) -> Tally {
             }
         }
         t.stance = Some((tp, fp, fn_));
+        // The zero-velocity instants (each stride's start) inside a Vicon stance.
+        let rows = from..to;
+        let instants: Vec<bool> = det
+            .iter()
+            .map(|d| clock.row_of_number(d.start) as usize)
+            .filter(|k| rows.contains(k))
+            .map(|k| label[k])
+            .collect();
+        t.instants = Some((instants.iter().filter(|&&s| s).count(), instants.len()));
     }
     t
 }
@@ -839,13 +965,16 @@ fn fmt_ms(v: &[f64]) -> String {
     }
 }
 
-/// The cells `found | extra | missed | precision | recall | F1` of a tally.
+/// The cells `found | extra | missed | not scored | unbordered | precision | recall | F1`
+/// of a tally.
 fn detection_cells(t: &Tally) -> String {
     format!(
-        "{} | {} | {} | {} | {} | {}",
+        "{} | {} | {} | {} | {} | {} | {} | {}",
         t.tp,
         t.fp,
         t.fn_,
+        t.unscored,
+        t.unbordered,
         fmt3(t.precision()),
         fmt3(t.recall()),
         fmt3(t.f1())
@@ -864,11 +993,11 @@ fn phase_cell(p: &PhaseTally) -> String {
 /// table of the rotated runs pooled and the largest change of any rotation.
 pub fn table(results: &[DatasetResult]) -> String {
     let mut s = String::new();
-    let header = "| dataset | trials | clean strides | found | extra | missed | precision | recall | F1 | toe-off \\|error\\| ms: median / p95 (signed median) | heel-strike \\|error\\| ms: median / p95 (signed median) | swing F / IoU | contact F / IoU | stance F1 |\n|---|---|---|---|---|---|---|---|---|---|---|---|---|---|\n";
+    let header = "| dataset | trials | clean strides | found | extra | missed | not scored | unbordered movements | precision | recall | F1 | toe-off \\|error\\| ms: median / p95 (signed median) | heel-strike \\|error\\| ms: median / p95 (signed median) | swing F / IoU | contact F / IoU | stance F1 | zero-velocity instants in a Vicon stance |\n|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|\n";
     let row = |s: &mut String, name: &str, t: &Tally| {
         let _ = writeln!(
             s,
-            "| {name} | {} | {} | {} | {} | {} | {} | {} | {} |",
+            "| {name} | {} | {} | {} | {} | {} | {} | {} | {} | {} |",
             t.trials,
             t.clean,
             detection_cells(t),
@@ -877,6 +1006,10 @@ pub fn table(results: &[DatasetResult]) -> String {
             phase_cell(&t.swing),
             phase_cell(&t.contact),
             t.stance_f1().map_or("–".into(), fmt3),
+            t.instants.map_or("–".into(), |(i, n)| format!(
+                "{i} / {n} ({:.1} %)",
+                100.0 * ratio(i as f64, n as f64)
+            )),
         );
     };
     s.push_str(header);
@@ -981,7 +1114,7 @@ pub fn data_table(datasets: &[Dataset]) -> Result<String> {
 /// recorded), with Lu's eq. 13 step-count error as the mean over trials and pooled.
 pub fn detectors_table(rows: &[(&str, &str, &Tally)]) -> String {
     let mut s = String::from(
-        "| dataset | detector | strides (all / clean) | detected | found | extra | missed | precision | recall | F1 | count error (eq. 13): mean of trials / pooled |\n|---|---|---|---|---|---|---|---|---|---|---|\n",
+        "| dataset | detector | strides (all / clean) | detected | found | extra | missed | not scored | unbordered movements | precision | recall | F1 | count error (eq. 13): mean of trials / pooled | too long (merged) |\n|---|---|---|---|---|---|---|---|---|---|---|---|---|---|\n",
     );
     for (dataset, detector, t) in rows {
         let pct = |v: f64| {
@@ -993,13 +1126,14 @@ pub fn detectors_table(rows: &[(&str, &str, &Tally)]) -> String {
         };
         let _ = writeln!(
             s,
-            "| {dataset} | {detector} | {} / {} | {} | {} | {} / {} |",
+            "| {dataset} | {detector} | {} / {} | {} | {} | {} / {} | {} |",
             t.references,
             t.clean,
             t.detected,
             detection_cells(t),
             pct(mean(&t.count_errors)),
             pct(t.pooled_count_error()),
+            t.too_long,
         );
     }
     s

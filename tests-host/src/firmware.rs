@@ -64,7 +64,11 @@ pub fn build_for(
 ) -> anyhow::Result<PathBuf> {
     use gaitclip::pipeline::Detector;
     match detector {
-        Detector::Stance => build_with(dir, bin, target, &[], env),
+        // The firmware's default detector.
+        Detector::Cycle => build_with(dir, bin, target, &[], env),
+        Detector::Stance => {
+            anyhow::bail!("the firmware runs the cycle or the peak-valley detector, not Huang's stance detector")
+        }
         Detector::PeakValley => {
             let mut env = env.to_vec();
             env.push(("CARGO_TARGET_DIR", "target/peak-valley".as_ref()));

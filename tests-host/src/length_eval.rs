@@ -1,15 +1,29 @@
-//! Stride lengths scored against the references, every model side by side.
+//! Stride lengths scored against the references, every model side by side, three ways
+//! ([`Validation`]):
 //!
-//! Trained models are scored only on strides their training never saw: the training
-//! datasets are cut into [`train::FOLDS`] folds grouped by trial, each fold is predicted by
-//! models fitted on the others (with the shipped SVR hyper-parameters), and datasets that
-//! are not trained on (`ipol_gait_events`) are predicted by the shipped fit. Every
-//! prediction is the core's fixed-point one.
+//! - **in-sample**: every model fitted on every training stride (`gaitmap_walk` and
+//!   `pyshoe_vicon`), the scored ones included: what a fit can do on its own data;
+//! - **5-fold by trial**: the training datasets cut into [`train::FOLDS`] folds grouped by
+//!   trial, each fold predicted by models fitted on the others (the shipped SVR
+//!   hyper-parameters): new walks of the same people, sensors and rooms;
+//! - **leave-one-dataset-out**: each training dataset predicted by models fitted on the
+//!   other alone, SVR hyper-parameters chosen there too: a new sensor, mounting, room and
+//!   population, which is what a user's walks are. The shipped default is the model best
+//!   here ([`lodo_best`]).
+//!
+//! Datasets not trained on (`ipol_gait_events`) are predicted by the fit on every training
+//! stride in all three: that fit never saw them. Every prediction is the core's fixed-point
+//! one. The ZUPT stride is fitted to nothing, so its three rows agree.
 //!
 //! Per model and dataset: RMSE, MAE and bias (predicted − reference) over matched clean
-//! strides (reference unflagged, stride valid), and the walked-distance error per trial,
-//! `|Σ predicted − Σ reference| / Σ reference` over all the core's strides in the trial's
-//! span (median and worst).
+//! strides (reference unflagged, stride valid, and no second movement inside the
+//! reference's borders: see [`crate::eval::Scored::Unbordered`]), the same by stride speed
+//! (reference length over reference duration) and by stride length, and the walked-distance
+//! error per trial, `|Σ predicted − Σ reference| / Σ reference` over all the core's strides
+//! in the trial's span where the trial's walked distance is known (`gaitmap_walk`: its
+//! reference strides follow one another; `ipol_gait_events`: the nominal 20 m), else over
+//! its scored strides (`pyshoe_vicon`, whose walks leave the capture volume) (median and
+//! worst).
 
 use std::collections::BTreeMap;
 use std::fmt::Write as _;
@@ -17,7 +31,7 @@ use std::fmt::Write as _;
 use anyhow::Result;
 use gaitclip::models::{self, Model, ModelParams, MODELS};
 
-use crate::train::{self, HyperSet, Sample, Trained, TrialRun};
+use crate::train::{self, HyperSet, Sample, Trained, TrialRun, TRAINING_DATASETS};
 
 /// Predictions of every model for every stride of every run: `[run][stride][model]`, m.
 pub type Predictions = Vec<Vec<[f64; MODELS]>>;
@@ -70,6 +84,102 @@ pub fn cross_validate(runs: &[TrialRun], hyper: &HyperSet) -> Result<(Prediction
     Ok((out, full))
 }
 
+/// How the trained models' predictions of a dataset were obtained (see the module).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Validation {
+    /// Fitted on every training stride.
+    InSample,
+    /// [`train::FOLDS`]-fold by trial.
+    KFold,
+    /// Fitted on the other training dataset.
+    LeaveOneDatasetOut,
+}
+
+impl Validation {
+    /// All three, in the order the tables give them.
+    pub const ALL: [Validation; 3] = [
+        Validation::InSample,
+        Validation::KFold,
+        Validation::LeaveOneDatasetOut,
+    ];
+
+    /// Its name in the tables.
+    pub const fn name(self) -> &'static str {
+        match self {
+            Validation::InSample => "in-sample",
+            Validation::KFold => "5-fold by trial",
+            Validation::LeaveOneDatasetOut => "leave-one-dataset-out",
+        }
+    }
+}
+
+fn dataset_of(s: &Sample) -> &str {
+    s.group.split('/').next().unwrap_or("")
+}
+
+/// Fixed-point predictions of every model for `runs`, validated as `v`: in-sample and
+/// k-fold with the SVR hyper-parameters `hyper`; leave-one-dataset-out chooses its own on
+/// the dataset it fits ([`train::choose_hyper`]), so that nothing of the scored dataset
+/// reaches the model.
+pub fn predictions(runs: &[TrialRun], hyper: &HyperSet, v: Validation) -> Result<Predictions> {
+    match v {
+        Validation::KFold => Ok(cross_validate(runs, hyper)?.0),
+        Validation::InSample => {
+            let samples = train::samples(runs);
+            let all: Vec<&Sample> = samples.iter().collect();
+            let full = train::fit_all(&all, hyper)?;
+            Ok(runs
+                .iter()
+                .map(|run| full.with_params(|p| predict_run(run, p)))
+                .collect())
+        }
+        Validation::LeaveOneDatasetOut => {
+            let samples = train::samples(runs);
+            let all: Vec<&Sample> = samples.iter().collect();
+            let full = train::fit_all(&all, hyper)?;
+            let mut fits: BTreeMap<&str, Trained> = BTreeMap::new();
+            for left_out in TRAINING_DATASETS {
+                let rest: Vec<Sample> = samples
+                    .iter()
+                    .filter(|s| dataset_of(s) != left_out)
+                    .cloned()
+                    .collect();
+                if rest.is_empty() || rest.len() == samples.len() {
+                    continue;
+                }
+                let (h, _) = train::choose_hyper(&rest)?;
+                let refs: Vec<&Sample> = rest.iter().collect();
+                fits.insert(left_out, train::fit_all(&refs, &h)?);
+            }
+            Ok(runs
+                .iter()
+                .map(|run| {
+                    let model = fits.get(run.dataset.as_str()).unwrap_or(&full);
+                    model.with_params(|p| predict_run(run, p))
+                })
+                .collect())
+        }
+    }
+}
+
+/// The model with the best leave-one-dataset-out score: the lowest mean over the training
+/// datasets of their RMSE (each dataset weighs the same, however many strides it has).
+pub fn lodo_best(scores: &[DatasetScores]) -> Model {
+    let score = |m: Model| {
+        let r: Vec<f64> = scores
+            .iter()
+            .filter(|(d, _)| TRAINING_DATASETS.contains(&d.as_str()))
+            .map(|(_, s)| s[m as usize].rmse())
+            .collect();
+        r.iter().sum::<f64>() / r.len().max(1) as f64
+    };
+    Model::ALL
+        .into_iter()
+        .filter(|&m| !score(m).is_nan())
+        .min_by(|&a, &b| score(a).total_cmp(&score(b)))
+        .unwrap_or(Model::Zupt)
+}
+
 /// One model's scores on one dataset.
 #[derive(Clone, Debug, Default)]
 pub struct LengthScore {
@@ -77,11 +187,70 @@ pub struct LengthScore {
     pub strides: usize,
     /// Per-stride errors, m.
     pub errors: Vec<f64>,
+    /// Their reference lengths, m.
+    pub reference_m: Vec<f64>,
+    /// Their reference speeds, m/s.
+    pub speed_mps: Vec<f64>,
     /// Walked-distance error per trial, fraction.
     pub distance: Vec<f64>,
 }
 
+/// One dataset's name and the score of every model on it (indexed by `Model as usize`).
+pub type DatasetScores = (String, [LengthScore; MODELS]);
+
+/// Stride-speed bins of the per-pace tables, m/s: slow walking, walking, fast walking,
+/// jogging, running.
+pub const SPEED_BINS: [(f64, f64); 5] = [
+    (0.0, 1.0),
+    (1.0, 1.5),
+    (1.5, 2.0),
+    (2.0, 3.0),
+    (3.0, f64::INFINITY),
+];
+
+/// Stride-length bins, m.
+pub const LENGTH_BINS: [(f64, f64); 5] = [
+    (0.0, 0.6),
+    (0.6, 1.0),
+    (1.0, 1.4),
+    (1.4, 1.8),
+    (1.8, f64::INFINITY),
+];
+
+/// What a per-bin table groups by.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum BinBy {
+    /// [`SPEED_BINS`].
+    Speed,
+    /// [`LENGTH_BINS`].
+    Length,
+}
+
 impl LengthScore {
+    /// The strides whose speed (or length) falls in `[lo, hi)`.
+    pub fn bin(&self, by: BinBy, (lo, hi): (f64, f64)) -> LengthScore {
+        let key = match by {
+            BinBy::Speed => &self.speed_mps,
+            BinBy::Length => &self.reference_m,
+        };
+        let mut out = LengthScore::default();
+        for (k, &v) in key.iter().enumerate() {
+            if v >= lo && v < hi {
+                out.strides += 1;
+                out.errors.push(self.errors[k]);
+                out.reference_m.push(self.reference_m[k]);
+                out.speed_mps.push(self.speed_mps[k]);
+            }
+        }
+        out
+    }
+
+    /// `|Σ predicted − Σ reference| / Σ reference` over the strides, fraction.
+    pub fn pooled_distance_error(&self) -> f64 {
+        let r: f64 = self.reference_m.iter().sum();
+        self.errors.iter().sum::<f64>().abs() / r
+    }
+
     /// RMSE, m.
     pub fn rmse(&self) -> f64 {
         (self.errors.iter().map(|e| e * e).sum::<f64>() / self.errors.len() as f64).sqrt()
@@ -97,7 +266,7 @@ impl LengthScore {
 }
 
 /// Scores per dataset (in order of first appearance) and model.
-pub fn score(runs: &[TrialRun], pred: &Predictions) -> Vec<(String, [LengthScore; MODELS])> {
+pub fn score(runs: &[TrialRun], pred: &Predictions) -> Vec<DatasetScores> {
     let mut by: BTreeMap<String, [LengthScore; MODELS]> = BTreeMap::new();
     let mut order = Vec::new();
     for (run, p) in runs.iter().zip(pred) {
@@ -107,15 +276,32 @@ pub fn score(runs: &[TrialRun], pred: &Predictions) -> Vec<(String, [LengthScore
         let s = by.entry(run.dataset.clone()).or_default();
         for m in Model::ALL {
             let k = m as usize;
-            for (r, p) in run.reference.iter().zip(p) {
+            for ((r, v), p) in run.reference.iter().zip(&run.speed_mps).zip(p) {
                 if let Some(r) = r {
                     s[k].strides += 1;
                     s[k].errors.push(p[k] - r);
+                    s[k].reference_m.push(*r);
+                    s[k].speed_mps.push(v.unwrap_or(f64::NAN));
                 }
             }
-            if let Some(total) = run.reference_total_m {
-                let sum: f64 = p.iter().map(|p| p[k]).sum();
-                s[k].distance.push((sum - total).abs() / total);
+            match run.reference_total_m {
+                Some(total) => {
+                    let sum: f64 = p.iter().map(|p| p[k]).sum();
+                    s[k].distance.push((sum - total).abs() / total);
+                }
+                // The walk is not known end to end: the distance of its scored strides.
+                None => {
+                    let (mut sum, mut total) = (0.0, 0.0);
+                    for (r, p) in run.reference.iter().zip(p) {
+                        if let Some(r) = r {
+                            sum += p[k];
+                            total += r;
+                        }
+                    }
+                    if total > 0.0 {
+                        s[k].distance.push((sum - total).abs() / total);
+                    }
+                }
             }
         }
     }
@@ -141,7 +327,7 @@ fn median(v: &[f64]) -> f64 {
 
 /// The Markdown table: one row per model, per dataset RMSE / MAE / bias in cm and the
 /// walked-distance error (median / worst trial, %).
-pub fn table(scores: &[(String, [LengthScore; MODELS])]) -> String {
+pub fn table(scores: &[DatasetScores]) -> String {
     let mut s = String::from("| model |");
     let mut rule = String::from("|---|");
     for (d, sc) in scores {
@@ -185,6 +371,170 @@ pub fn table(scores: &[(String, [LengthScore; MODELS])]) -> String {
         s.push('\n');
     }
     s
+}
+
+/// Every model's RMSE and bias (cm) per dataset three ways: one row per model, a column
+/// per dataset and validation; datasets without per-stride lengths get their walked-distance
+/// error (median / worst trial) instead.
+pub fn three_ways_table(by: &[(Validation, Vec<DatasetScores>)]) -> String {
+    let Some((_, first)) = by.first() else {
+        return String::new();
+    };
+    let mut s = String::from("| model |");
+    let mut rule = String::from("|---|");
+    for (d, sc) in first {
+        for (v, _) in by {
+            if sc[0].strides > 0 {
+                let _ = write!(s, " {d}, {}: RMSE / bias cm |", v.name());
+            } else {
+                let _ = write!(s, " {d}, {}: distance error median / worst |", v.name());
+            }
+            rule.push_str("---|");
+        }
+    }
+    s.push('\n');
+    s.push_str(&rule);
+    s.push('\n');
+    for m in Model::ALL {
+        let k = m as usize;
+        let _ = write!(s, "| `{}` |", m.name());
+        for (i, (_, sc)) in first.iter().enumerate() {
+            for (_, scores) in by {
+                let x = &scores[i].1[k];
+                if sc[0].strides > 0 {
+                    let _ = write!(s, " {:.1} / {:+.1} |", x.rmse() * 100.0, x.bias() * 100.0);
+                } else {
+                    let worst = x.distance.iter().cloned().fold(0.0, f64::max);
+                    let _ = write!(
+                        s,
+                        " {:.1} % / {:.1} % |",
+                        median(&x.distance) * 100.0,
+                        worst * 100.0
+                    );
+                }
+            }
+        }
+        s.push('\n');
+    }
+    s
+}
+
+/// RMSE / bias (cm) per speed or length bin, one row per model, a column per dataset (with
+/// per-stride lengths) and bin, and the pooled distance error of each bin's strides.
+pub fn binned_table(scores: &[DatasetScores], by: BinBy) -> String {
+    let bins: &[(f64, f64)] = match by {
+        BinBy::Speed => &SPEED_BINS,
+        BinBy::Length => &LENGTH_BINS,
+    };
+    let unit = match by {
+        BinBy::Speed => "m/s",
+        BinBy::Length => "m",
+    };
+    let label = |&(lo, hi): &(f64, f64)| {
+        if hi.is_infinite() {
+            format!("> {lo} {unit}")
+        } else if lo == 0.0 {
+            format!("< {hi} {unit}")
+        } else {
+            format!("{lo}–{hi} {unit}")
+        }
+    };
+    let with: Vec<&DatasetScores> = scores.iter().filter(|(_, s)| s[0].strides > 0).collect();
+    let mut s = String::from("| model |");
+    let mut rule = String::from("|---|");
+    for (d, sc) in &with {
+        for b in bins {
+            let _ = write!(s, " {d} {} ({}) |", label(b), sc[0].bin(by, *b).strides);
+            rule.push_str("---|");
+        }
+    }
+    s.push('\n');
+    s.push_str(&rule);
+    s.push('\n');
+    for m in Model::ALL {
+        let _ = write!(s, "| `{}` |", m.name());
+        for (_, sc) in &with {
+            for b in bins {
+                let x = sc[m as usize].bin(by, *b);
+                if x.strides == 0 {
+                    s.push_str(" – |");
+                } else {
+                    let _ = write!(
+                        s,
+                        " {:.1} / {:+.1} / {:.1} % |",
+                        x.rmse() * 100.0,
+                        x.bias() * 100.0,
+                        x.pooled_distance_error() * 100.0
+                    );
+                }
+            }
+        }
+        s.push('\n');
+    }
+    s
+}
+
+/// Walked distance per trial by `model`: one row per trial whose walked distance is known
+/// ([`TrialRun::reference_total_m`]), with the reference and the error.
+pub fn walked_table(runs: &[TrialRun], pred: &Predictions, model: Model) -> String {
+    let mut s = String::from(
+        "| dataset | trial | strides | walked (m) | reference (m) | error |\n|---|---|---:|---:|---:|---:|\n",
+    );
+    for (run, p) in runs.iter().zip(pred) {
+        let Some(total) = run.reference_total_m else {
+            continue;
+        };
+        let sum: f64 = p.iter().map(|p| p[model as usize]).sum();
+        let _ = writeln!(
+            s,
+            "| {} | {} | {} | {sum:.2} | {total:.2} | {:+.1} % |",
+            run.dataset,
+            run.trial,
+            p.len(),
+            (sum - total) / total * 100.0
+        );
+    }
+    s
+}
+
+/// Stride-length error of `model` against the reference stride's speed, one colour per
+/// dataset with per-stride lengths, as an SVG document.
+pub fn speed_plot(runs: &[TrialRun], pred: &Predictions, model: Model) -> String {
+    const COLOURS: [&str; 4] = ["#1f77b4", "#ff7f0e", "#2ca02c", "#9467bd"];
+    let mut by: Vec<(String, Vec<(f64, f64)>)> = Vec::new();
+    for (run, p) in runs.iter().zip(pred) {
+        for ((r, v), p) in run.reference.iter().zip(&run.speed_mps).zip(p) {
+            if let (Some(r), Some(v)) = (r, v) {
+                let k = match by.iter().position(|(d, _)| *d == run.dataset) {
+                    Some(k) => k,
+                    None => {
+                        by.push((run.dataset.clone(), Vec::new()));
+                        by.len() - 1
+                    }
+                };
+                by[k].1.push((*v, (p[model as usize] - r) * 100.0));
+            }
+        }
+    }
+    let vmax = by
+        .iter()
+        .flat_map(|(_, p)| p.iter().map(|p| p.0))
+        .fold(1.0, f64::max)
+        .ceil();
+    let mut plot = Plot::new(
+        &format!("{}: stride length error against speed", model.name()),
+        "reference stride speed (m/s)",
+        "predicted − reference (cm)",
+        (0.0, vmax),
+        (-25.0, 25.0),
+    );
+    plot.line((0.0, 0.0), (vmax, 0.0), "", true);
+    for (k, (d, pts)) in by.iter().enumerate() {
+        let colour = COLOURS[k % COLOURS.len()];
+        plot.points_in(pts, colour);
+        plot.legend(k, &format!("{d} ({} strides)", pts.len()), colour);
+    }
+    plot.finish()
 }
 
 /// Matched clean strides of the training datasets: (reference, predicted by `model`), m.
@@ -273,14 +623,31 @@ impl Plot {
     }
 
     fn points(&mut self, pts: &[(f64, f64)]) {
+        self.points_in(pts, "#1f77b4");
+    }
+
+    fn points_in(&mut self, pts: &[(f64, f64)], colour: &str) {
         for &(x, y) in pts {
             let _ = writeln!(
                 self.svg,
-                "<circle cx=\"{:.1}\" cy=\"{:.1}\" r=\"2\" fill=\"#1f77b4\" fill-opacity=\"0.5\"/>",
+                "<circle cx=\"{:.1}\" cy=\"{:.1}\" r=\"2\" fill=\"{colour}\" fill-opacity=\"0.5\"/>",
                 self.px(x.clamp(self.x.0, self.x.1)),
                 self.py(y.clamp(self.y.0, self.y.1))
             );
         }
+    }
+
+    fn legend(&mut self, row: usize, label: &str, colour: &str) {
+        let (x, y) = (
+            self.px(self.x.0) + 10.0,
+            self.py(self.y.1) + 16.0 + 16.0 * row as f64,
+        );
+        let _ = writeln!(
+            self.svg,
+            "<circle cx=\"{x:.1}\" cy=\"{:.1}\" r=\"4\" fill=\"{colour}\"/><text x=\"{:.1}\" y=\"{y:.1}\">{label}</text>",
+            y - 4.0,
+            x + 8.0
+        );
     }
 
     fn line(&mut self, a: (f64, f64), b: (f64, f64), label: &str, dash: bool) {

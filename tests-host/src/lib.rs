@@ -5,6 +5,7 @@
 pub mod clock;
 pub mod cost;
 pub mod csv_trace;
+pub mod cycle_ref;
 pub mod datasets;
 pub mod eval;
 pub mod firmware;
@@ -22,3 +23,4 @@ pub mod replay;
 pub mod sim;
 pub mod trace;
 pub mod train;
+pub mod zupt_sweep;

@@ -400,7 +400,9 @@ impl Tracker {
                     heel_off: self.heel_off as u32,
                     toe_off: (self.heel_off + to) as u32,
                     heel_strike: (self.heel_off + hs) as u32,
+                    foot_flat: at as u32,
                     end: at as u32,
+                    too_long: false,
                 };
                 self.stance_start = at;
                 self.pending.replace(d)

@@ -148,7 +148,7 @@ pub struct StrideReport {
     pub length_m: f64,
     /// Name of the model behind `length_m`.
     pub model: &'static str,
-    /// The step detector (`stance`, or `lu`: then `heel_off_s`/`toe_off_s` are the step's
+    /// The step detector (`cycle`, `stance`, or `lu`: then `heel_off_s`/`toe_off_s` are the step's
     /// peak, `heel_strike_s`/`foot_flat_s` its valley).
     pub detector: &'static str,
     /// Every model's length, m, by model name (`--all-models`).
@@ -162,7 +162,8 @@ pub struct StrideReport {
     pub toe_off_s: f64,
     /// Heel-strike, s.
     pub heel_strike_s: f64,
-    /// Foot-flat ending the stride, s (same as `end_s`).
+    /// Foot-flat ending the movement, s (the stance detector's `end_s`; the cycle
+    /// detector's stride goes on to the stance instant, `end_s`).
     pub foot_flat_s: f64,
     /// Height gained, m.
     pub climb_m: f64,
@@ -207,6 +208,9 @@ pub fn flag_names(f: StrideFlags) -> Vec<&'static str> {
     }
     if f.has(StrideFlags::BRIDGED) {
         v.push("bridged");
+    }
+    if f.has(StrideFlags::GYRO_CLIPPED) {
+        v.push("gyro_clipped");
     }
     v
 }
@@ -381,16 +385,17 @@ pub fn replay(trace: &Trace, ranges: Ranges) -> Result<Vec<StrideReport>, Replay
     replay_model(
         trace,
         ranges,
-        Detector::Stance,
+        Detector::Cycle,
         gaitclip::pipeline::DEFAULT_MODEL,
         false,
     )
 }
 
 /// Replays a trace in physical units: converts to counts at `ranges` (with saturation)
-/// first; `detector` segments it, `model` gives `length_m` (the stance detector's strides;
-/// the peak-valley detector's steps are measured by Lu's chain), and with `all_models` every
-/// model's length is added (stance detector only: the models need its features).
+/// first; `detector` segments it, `model` gives `length_m` (the cycle and stance detectors'
+/// strides; the peak-valley detector's steps are measured by Lu's chain), and with
+/// `all_models` every model's length is added (not for peak-valley steps: the models need
+/// the phases' features).
 pub fn replay_model(
     trace: &Trace,
     ranges: Ranges,
@@ -423,7 +428,7 @@ pub fn replay_summarised(
             ..report(s, config, &|n| clock.t_s(n))
         })
         .collect();
-    if all_models && detector == Detector::Stance {
+    if all_models && detector != Detector::PeakValley {
         for r in &mut out {
             if r.raw.flags.has(StrideFlags::GAP) {
                 // No length across a gap, from any model.
@@ -457,7 +462,7 @@ fn report(s: Stride, config: Config, t_s: &impl Fn(u32) -> f64) -> StrideReport 
         heel_off_s: t_s(s.heel_off),
         toe_off_s: t_s(s.toe_off),
         heel_strike_s: t_s(s.heel_strike),
-        foot_flat_s: t_s(s.end),
+        foot_flat_s: t_s(s.foot_flat),
         climb_m: s.climb_mm as f64 / 1000.0,
         valid: s.flags.valid(),
         flags: flag_names(s.flags),

@@ -23,7 +23,6 @@ use anyhow::{bail, Context, Result};
 use gaitclip::features::{self, Features, COUNT, PER_SEGMENT, ZUPT_LENGTH};
 use gaitclip::models::{Model, ModelParams, Settings, LINEAR_MODELS, MAX_TERMS};
 use gaitclip::phase_stats::{Channel, Segment, StrideStats};
-use gaitclip::pipeline::DEFAULT_MODEL;
 use gaitclip::rate::SampleRate;
 use gaitclip::stride::Stride;
 use gaitclip::svr::{Boosted, Svr};
@@ -35,9 +34,9 @@ use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 
 use crate::eval::{self, Dataset, Detected};
-use crate::length_ref;
 use crate::trace::Ranges;
 use crate::{csv_trace, replay};
+use crate::{length_eval, length_ref};
 
 /// Folds of the grouped cross-validation.
 pub const FOLDS: usize = 5;
@@ -74,8 +73,12 @@ pub struct TrialRun {
     pub fixed: Vec<Features>,
     /// Reference length of each stride where it is matched to a clean reference and valid.
     pub reference: Vec<Option<f64>>,
-    /// Distance walked over the span by the reference, m (all reference strides, or the
-    /// dataset's walked distance).
+    /// The reference stride's speed, m/s (length over the reference's duration), where
+    /// there is a reference length.
+    pub speed_mps: Vec<Option<f64>>,
+    /// Distance walked over the span by the reference, m: the dataset's walked distance, or
+    /// the sum of its reference strides where they follow one another without a break
+    /// (`None` where they do not: the walk left the capture volume).
     pub reference_total_m: Option<f64>,
     /// Device settings (the walker's height where known).
     pub settings: Settings,
@@ -103,17 +106,36 @@ pub fn run_dataset(dataset: &Dataset) -> Result<Vec<TrialRun>> {
             })
             .unzip();
         let det: Vec<Detected> = strides.iter().map(Detected::from).collect();
+        let scored = eval::classify(trial, &prepared.clock, &det, &references);
+        // A reference that holds a movement its borders leave out measured two movements:
+        // no length to compare one stride with.
+        let holds_two = |r: &eval::Reference| {
+            det.iter().zip(&scored).any(|(d, c)| {
+                *c == eval::Scored::Unbordered
+                    && 2 * (d.foot_flat.min(r.end)).saturating_sub(d.heel_off.max(r.start))
+                        >= d.foot_flat - d.heel_off
+            })
+        };
         let mut reference = vec![None; strides.len()];
-        for (i, j) in eval::match_strides(&det, &references) {
-            let r = &references[j];
-            if !r.flagged && strides[i].flags.valid() {
-                reference[i] = r.length_m;
+        let mut speed_mps = vec![None; strides.len()];
+        for (i, c) in scored.iter().enumerate() {
+            if let eval::Scored::Found(j) = *c {
+                let r = &references[j];
+                if strides[i].flags.valid() && !holds_two(r) {
+                    reference[i] = r.length_m;
+                    let duration_s =
+                        r.end.saturating_sub(r.start) as f64 / prepared.clock.rate_hz();
+                    speed_mps[i] = r.length_m.map(|l| l / duration_s);
+                }
             }
         }
         let lengths: Vec<f64> = trial.references.iter().filter_map(|r| r.length_m).collect();
+        // The reference strides give the walk's length only when they follow one another
+        // without a break (`pyshoe_vicon`'s leave the capture volume and come back).
+        let contiguous = trial.references.windows(2).all(|w| w[0].end == w[1].start);
         let reference_total_m = trial
             .distance_m
-            .or((!lengths.is_empty()).then(|| lengths.iter().sum()));
+            .or((contiguous && !lengths.is_empty()).then(|| lengths.iter().sum()));
         let settings = trial.height_m.map_or(Settings::DEFAULT, |h| Settings {
             height_mm: (h * 1000.0).round() as u16,
         });
@@ -134,6 +156,7 @@ pub fn run_dataset(dataset: &Dataset) -> Result<Vec<TrialRun>> {
             strides,
             stats,
             reference,
+            speed_mps,
             reference_total_m,
             settings,
         });
@@ -732,6 +755,11 @@ pub struct Training {
     pub cv_rmse: [f64; 4],
     /// Trials trained on.
     pub trials: usize,
+    /// The leave-one-dataset-out scores of every model ([`length_eval::score`] of
+    /// [`length_eval::Validation::LeaveOneDatasetOut`]).
+    pub lodo: Vec<length_eval::DatasetScores>,
+    /// The model with the best of them ([`length_eval::lodo_best`]): the firmware's default.
+    pub default_model: Model,
 }
 
 /// Trains every model on `runs`.
@@ -741,18 +769,23 @@ pub fn train(runs: &[TrialRun]) -> Result<Training> {
     let refs: Vec<&Sample> = s.iter().collect();
     let trained = fit_all(&refs, &hyper)?;
     let trials = folds(s.iter().map(|s| s.group.clone())).len();
+    let pred = length_eval::predictions(runs, &hyper, length_eval::Validation::LeaveOneDatasetOut)?;
+    let lodo = length_eval::score(runs, &pred);
+    let default_model = length_eval::lodo_best(&lodo);
     Ok(Training {
         trained,
         hyper,
         cv_rmse,
         trials,
+        lodo,
+        default_model,
     })
 }
 
 /// `#[cfg]` line of the tables of a model that only builds with the `all-models` feature
 /// (every SVR model but the pipeline's default), or nothing.
-fn gate(model: Model) -> &'static str {
-    if model == DEFAULT_MODEL {
+fn gate(model: Model, default: Model) -> &'static str {
+    if model == default {
         ""
     } else {
         "#[cfg(feature = \"all-models\")]\n"
@@ -760,8 +793,8 @@ fn gate(model: Model) -> &'static str {
 }
 
 /// A `PARAMS` field: the trained value, or `absent` in builds without the model.
-fn field(model: Model, name: &str, value: &str, absent: &str) -> String {
-    if model == DEFAULT_MODEL {
+fn field(model: Model, default: Model, name: &str, value: &str, absent: &str) -> String {
+    if model == default {
         format!("    {name}: {value},\n")
     } else {
         format!(
@@ -824,17 +857,17 @@ pub fn rust_source(t: &Training) -> String {
         .iter()
         .zip(["PUSH_OFF", "SWING", "HEEL_STRIKE"])
         .map(|(s, n)| {
-            let g = gate(Model::HuangSvrFusion);
+            let g = gate(Model::HuangSvrFusion, t.default_model);
             svr_source(&mut body, g, &format!("FUSION_{n}"), &s.quantize())
         })
         .collect();
     let whole = svr_source(
         &mut body,
-        gate(Model::HuangSvrWhole),
+        gate(Model::HuangSvrWhole, t.default_model),
         "WHOLE",
         &tr.whole.quantize(),
     );
-    let boost_gate = gate(Model::HuangSvrAdaBoost);
+    let boost_gate = gate(Model::HuangSvrAdaBoost, t.default_model);
     let mut boosted = Vec::new();
     for (b, n) in tr.adaboost.iter().zip(["PUSH_OFF", "SWING", "HEEL_STRIKE"]) {
         let members: Vec<String> = b
@@ -891,7 +924,29 @@ pub fn rust_source(t: &Training) -> String {
             r
         );
     }
-    s.push_str("\nuse crate::models::ModelParams;\nuse crate::svr::{Boosted, Svr};\n\n");
+    s.push_str("//!\n//! Leave-one-dataset-out (each training dataset predicted by a fit on the other alone), mean\n//! of the datasets' RMSE, best first:\n//!\n//! | model | mean RMSE (cm) |\n//! |---|---|\n");
+    let mut ranked: Vec<(Model, f64)> = Model::ALL
+        .into_iter()
+        .map(|m| {
+            let r: Vec<f64> = t
+                .lodo
+                .iter()
+                .filter(|(d, _)| TRAINING_DATASETS.contains(&d.as_str()))
+                .map(|(_, sc)| sc[m as usize].rmse())
+                .collect();
+            (m, r.iter().sum::<f64>() / r.len().max(1) as f64)
+        })
+        .collect();
+    ranked.sort_by(|a, b| a.1.total_cmp(&b.1));
+    for (m, r) in &ranked {
+        let _ = writeln!(s, "//! | `{}` | {:.2} |", m.name(), r * 100.0);
+    }
+    s.push_str("\nuse crate::models::{Model, ModelParams};\nuse crate::svr::{Boosted, Svr};\n\n");
+    let _ = writeln!(
+        s,
+        "/// The model with the best leave-one-dataset-out score: the pipeline's default\n/// ([`crate::pipeline::DEFAULT_MODEL`]).\npub const LODO_BEST: Model = Model::{:?};\n",
+        t.default_model
+    );
     s.push_str("/// The SVR hyper-parameters `[C, γ, ε (m)]` chosen by cross-validation, for push-off,\n/// swing, heel-strike and the whole movement: `gaitclip eval` re-fits each fold with them.\npub const HYPER: [[f64; 3]; 4] = [\n");
     for h in &t.hyper {
         let _ = writeln!(s, "    [{:?}, {:?}, {:?}],", h.c, h.gamma, h.eps);
@@ -915,13 +970,21 @@ pub fn rust_source(t: &Training) -> String {
     let _ = writeln!(s, "    ],\n    lu_d_range_q16: ({}, {}),", lu.0, lu.1);
     s.push_str(&field(
         Model::HuangSvrFusion,
+        t.default_model,
         "fusion",
         &format!("[\n        {},\n    ]", fusion.join(",\n        ")),
         "[Svr::ABSENT; 3]",
     ));
-    s.push_str(&field(Model::HuangSvrWhole, "whole", &whole, "Svr::ABSENT"));
+    s.push_str(&field(
+        Model::HuangSvrWhole,
+        t.default_model,
+        "whole",
+        &whole,
+        "Svr::ABSENT",
+    ));
     s.push_str(&field(
         Model::HuangSvrAdaBoost,
+        t.default_model,
         "adaboost",
         &format!("[\n        {},\n    ]", boosted.join(",\n        ")),
         "[Boosted::ABSENT; 3]",

@@ -107,7 +107,7 @@ fn run(t: &Trace) -> (Vec<StrideReport>, Summary) {
     replay_summarised(
         t,
         Ranges::default(),
-        gaitclip::pipeline::Detector::Stance,
+        gaitclip::pipeline::Detector::Cycle,
         gaitclip::pipeline::DEFAULT_MODEL,
         false,
     )
@@ -277,9 +277,12 @@ fn host_clock_stamps_give_the_strides_of_the_true_clock() {
             }
             // Holes inside a delivery: the stamps cannot place them, the angular rate does
             // for most; one a row off in a fast swing moves that stride by centimetres.
+            // Measured with the cycle detector: mean 1.98 mm, p95 14 mm (Huang's stance
+            // detector: under 1.5 mm; the rolling-contact velocity at a stance instant
+            // takes the rate of the very sample a misplaced hole shifts).
             Holes::InsideDeliveries => {
                 assert!(exact * 100 >= holes * 70, "{kind:?}: {exact} of {holes}");
-                assert!(mean <= 0.0015, "{kind:?}: mean {mean}");
+                assert!(mean <= 0.0025, "{kind:?}: mean {mean}");
             }
         }
     }

@@ -119,11 +119,11 @@ fn bench_runs_to_the_end_on_m0_with_each_detector() {
     let plugin = plugin();
     let scratch = tempdir("m0");
     let counts = gaitclip_host::fixtures::firmware_trace_counts().expect("demo trace");
-    for detector in [Detector::Stance, Detector::PeakValley] {
+    for detector in [Detector::Cycle, Detector::PeakValley] {
         let elf = firmware::build_for("boards/bench", "bench", "thumbv6m-none-eabi", detector, &[])
             .expect("the benchmark firmware builds for the M0");
         match detector {
-            Detector::Stance => {
+            Detector::Cycle | Detector::Stance => {
                 let r = cost::run_bench(&elf, qemu::MACHINE_M0, &plugin, &scratch)
                     .expect("counted run on the M0");
                 assert_eq!(r.samples as usize, counts.len());

@@ -100,9 +100,9 @@ fn eval_figures_on_recordings() {
     let detector = eval::core_detector(|_| {});
     // (dataset, min F1, max median |toe-off|, |heel-strike| ms, min swing IoU)
     for (name, f1, to, hs, iou) in [
-        ("gaitmap_walk", 0.97, 30.0, 70.0, 0.80),
-        ("pyshoe_vicon", 0.87, f64::NAN, f64::NAN, f64::NAN),
-        ("ipol_gait_events", 0.97, 45.0, 35.0, 0.82),
+        ("gaitmap_walk", 0.99, 30.0, 70.0, 0.80),
+        ("pyshoe_vicon", 0.99, f64::NAN, f64::NAN, f64::NAN),
+        ("ipol_gait_events", 0.98, 45.0, 35.0, 0.82),
     ] {
         let d = eval::load(&root.join(name)).unwrap();
         let r = eval::evaluate(&d, &detector, 0, 1).unwrap();
@@ -117,6 +117,12 @@ fn eval_figures_on_recordings() {
             t.swing.mean_iou()
         );
         assert!(t.f1() >= f1, "{name}: F1 {}", t.f1());
+        // Every gait cycle its own stance: no movement merges strides (issue 18).
+        assert_eq!(
+            t.too_long, 0,
+            "{name}: {} strides too long (merged)",
+            t.too_long
+        );
         if !to.is_nan() {
             assert!(m_to <= to && m_hs <= hs, "{name}: {m_to} / {m_hs} ms");
             assert!(

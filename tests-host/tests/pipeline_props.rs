@@ -80,8 +80,9 @@ fn check<const M: usize>(
             assert_eq!(s.length_mm, 0, "no length across a gap: {s:?}");
             assert!(!s.flags.valid());
         }
-        // The movement buffer holds M samples; a longer movement is flagged, not grown.
-        let moved_ms = (s.end - s.heel_off) as u64 * 1000 / rate_hz as u64;
+        // The movement buffer holds M samples of heel-off to foot-flat; a longer movement is
+        // flagged, not grown.
+        let moved_ms = (s.foot_flat - s.heel_off) as u64 * 1000 / rate_hz as u64;
         if moved_ms > buffer_ms + 1 && !s.flags.has(StrideFlags::GAP) {
             assert!(s.flags.has(StrideFlags::TOO_LONG), "{s:?}");
         }

@@ -4,7 +4,7 @@
 use std::path::Path;
 
 use gaitclip::phases::PhaseMethod;
-use gaitclip::pipeline::Config;
+use gaitclip::pipeline::{Config, Detector};
 use gaitclip_host::datasets;
 use gaitclip_host::eval::Detected;
 use gaitclip_host::trace::{Ranges, Trace};
@@ -16,6 +16,7 @@ fn compare(name: &str, trace: &Trace, method: PhaseMethod) -> Vec<u32> {
     let ranges = Ranges::default();
     let rate = trace.sample_rate().expect("rate in range");
     let mut config = Config::new(rate, ranges.accel, ranges.gyro);
+    config.detector = Detector::Stance;
     config.phases = method;
     let counts: Vec<_> = trace.samples.iter().map(|s| ranges.to_counts(s)).collect();
     let core: Vec<Detected> = replay::core_strides(&counts, config)

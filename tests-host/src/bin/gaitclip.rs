@@ -34,9 +34,10 @@ enum Cmd {
         /// One JSON object per stride per line.
         #[arg(long)]
         json: bool,
-        /// Step detector: `stance` (stance to stance, the firmware's default) or `lu` (Lu's
-        /// peak-valley detection, measured by Lu's chain: `--model lu_fuzzy`).
-        #[arg(long, value_name = "NAME", value_parser = detector_names(), default_value = Detector::Stance.name())]
+        /// Step detector: `cycle` (one zero-velocity instant per gait cycle at every pace,
+        /// the firmware's default), `stance` (Huang's variance + IQR stance detector) or `lu`
+        /// (Lu's peak-valley detection, measured by Lu's chain: `--model lu_fuzzy`).
+        #[arg(long, value_name = "NAME", value_parser = detector_names(), default_value = Detector::Cycle.name())]
         detector: String,
         /// Length model for `length_m` (default: the firmware's; `lu_fuzzy` with `--detector lu`).
         #[arg(long, value_name = "NAME", value_parser = model_names())]
@@ -64,8 +65,8 @@ enum Cmd {
         /// Phase splitter: Huang's major peak-valley pairs or the augmented version.
         #[arg(long, value_enum, default_value_t = PhasesArg::Augmented)]
         phases: PhasesArg,
-        /// Write the default model's Bland–Altman plot and predicted-vs-reference scatter
-        /// (SVG) into this folder.
+        /// Write the default model's Bland–Altman plot, predicted-vs-reference scatter and
+        /// error against speed (SVG, leave-one-dataset-out) into this folder.
         #[arg(long, value_name = "DIR")]
         plots: Option<PathBuf>,
         /// The stance detector's thresholds for the detection tables, as
@@ -107,6 +108,14 @@ enum Cmd {
     /// references and print what bridging them costs, by hole length (the README's hole
     /// table, and the bridge limit it gives).
     Holes {
+        /// The folder holding the datasets (`../shared/datasets`).
+        #[arg(default_value = "../../shared/datasets")]
+        datasets: PathBuf,
+    },
+    /// Sweep the ZUPT stride's physical settings on the datasets with per-stride lengths:
+    /// the sensor's height above the rolling contact, and the gyro's full-scale range
+    /// (clipping), by stride speed (the README's tables).
+    ZuptSweep {
         /// The folder holding the datasets (`../shared/datasets`).
         #[arg(default_value = "../../shared/datasets")]
         datasets: PathBuf,
@@ -266,7 +275,7 @@ fn run(cli: Cli) -> anyhow::Result<()> {
             let detector = Detector::from_name(&detector).context("unknown detector")?;
             let model = match (detector, model.as_deref()) {
                 (_, Some(name)) => Model::from_name(name).context("unknown model")?,
-                (Detector::Stance, None) => gaitclip::pipeline::DEFAULT_MODEL,
+                (Detector::Cycle | Detector::Stance, None) => gaitclip::pipeline::DEFAULT_MODEL,
                 (Detector::PeakValley, None) => Model::LuFuzzy,
             };
             if detector == Detector::PeakValley && (model != Model::LuFuzzy || all_models) {
@@ -341,7 +350,8 @@ fn run(cli: Cli) -> anyhow::Result<()> {
                     }
                 })
             };
-            let (stance, lu) = (run_with(Detector::Stance), run_with(Detector::PeakValley));
+            let detectors: Vec<(Detector, _)> =
+                Detector::ALL.iter().map(|&d| (d, run_with(d))).collect();
             let mut results = Vec::new();
             let mut side_by_side = Vec::new();
             let mut runs = Vec::new();
@@ -349,43 +359,83 @@ fn run(cli: Cli) -> anyhow::Result<()> {
             for dir in &datasets {
                 let d = eval::load(dir)?;
                 loaded.push(d.clone());
-                let by_stance = eval::evaluate(&d, &stance, rotate, seed)?;
-                let by_lu = eval::evaluate(&d, &lu, 0, seed)?;
-                side_by_side.push((d.name.clone(), by_stance.tally.clone(), by_lu.tally));
-                results.push(by_stance);
+                let mut tallies = Vec::new();
+                for (k, (which, det)) in detectors.iter().enumerate() {
+                    // The default detector gets the rotations and the event table.
+                    let r = eval::evaluate(&d, det, if k == 0 { rotate } else { 0 }, seed)?;
+                    tallies.push((*which, r.tally.clone()));
+                    if k == 0 {
+                        results.push(r);
+                    }
+                }
+                side_by_side.push((d.name.clone(), tallies));
                 runs.extend(train::run_dataset(&d)?);
             }
             println!("The recordings as read (stamps, repeated samples, holes and what the core did with them):\n");
             print!("{}", eval::data_table(&loaded)?);
-            println!();
+            println!(
+                "\nStrides, gait events and phases by the default detector (`{}`):\n",
+                Detector::ALL[0].name()
+            );
             print!("{}", eval::table(&results));
             let rows: Vec<(&str, &str, &eval::Tally)> = side_by_side
                 .iter()
-                .flat_map(|(name, s, l)| {
-                    [
-                        (name.as_str(), Detector::Stance.name(), s),
-                        (name.as_str(), Detector::PeakValley.name(), l),
-                    ]
-                })
+                .flat_map(|(name, t)| t.iter().map(move |(d, t)| (name.as_str(), d.name(), t)))
                 .collect();
-            println!("\nStep detectors side by side (stance: the table above; lu: Lu's peak-valley detection):\n");
+            println!("\nStep detectors side by side (cycle: every-pace stance instants, the default; stance: Huang's variance + IQR stance detector; lu: Lu's peak-valley detection):\n");
             print!("{}", eval::detectors_table(&rows));
             let hyper = train::hyper_from(&gaitclip::trained::HYPER);
-            let (pred, _) = length_eval::cross_validate(&runs, &hyper)?;
-            println!();
-            print!("{}", length_eval::table(&length_eval::score(&runs, &pred)));
+            let mut by = Vec::new();
+            for v in length_eval::Validation::ALL {
+                let pred = length_eval::predictions(&runs, &hyper, v)?;
+                by.push((v, length_eval::score(&runs, &pred), pred));
+            }
+            let scores: Vec<_> = by.iter().map(|(v, s, _)| (*v, s.clone())).collect();
+            println!("\nStride length, every model three ways (in-sample; 5-fold by trial; leave-one-dataset-out: fitted on the other training dataset alone). Datasets without per-stride lengths: walked-distance error per trial:\n");
+            print!("{}", length_eval::three_ways_table(&scores));
+            let (_, lodo, lodo_pred) = &by[2];
+            println!(
+                "\nBest leave-one-dataset-out (mean of the two datasets' RMSE): `{}`; the firmware's default: `{}`.",
+                length_eval::lodo_best(lodo).name(),
+                gaitclip::pipeline::DEFAULT_MODEL.name()
+            );
+            println!(
+                "\nLeave-one-dataset-out in full (RMSE / MAE / bias; walked distance per trial):\n"
+            );
+            print!("{}", length_eval::table(lodo));
+            println!("\nLeave-one-dataset-out by stride speed (RMSE / bias cm / distance error of the bin's strides; strides per bin in the header):\n");
+            print!(
+                "{}",
+                length_eval::binned_table(lodo, length_eval::BinBy::Speed)
+            );
+            println!("\nLeave-one-dataset-out by stride length:\n");
+            print!(
+                "{}",
+                length_eval::binned_table(lodo, length_eval::BinBy::Length)
+            );
+            println!("\nWalked distance per trial, default model (datasets that give the walk's length; `ipol_gait_events`: 20 m nominal, the U-turn's extra path not counted):\n");
+            print!(
+                "{}",
+                length_eval::walked_table(&runs, lodo_pred, gaitclip::pipeline::DEFAULT_MODEL)
+            );
             if let Some(dir) = plots {
                 let model = gaitclip::pipeline::DEFAULT_MODEL;
-                let pairs = length_eval::pairs(&runs, &pred, model);
+                std::fs::create_dir_all(&dir)?;
+                let pairs = length_eval::pairs(&runs, lodo_pred, model);
+                let mut files = Vec::new();
                 if !pairs.is_empty() {
                     let (ba, sc) = length_eval::plots(&pairs, model.name());
-                    std::fs::create_dir_all(&dir)?;
-                    for (name, svg) in [("bland_altman.svg", ba), ("scatter.svg", sc)] {
-                        let p = dir.join(name);
-                        std::fs::write(&p, svg)
-                            .with_context(|| format!("writing {}", p.display()))?;
-                        eprintln!("wrote {}", p.display());
-                    }
+                    files.push(("bland_altman.svg", ba));
+                    files.push(("scatter.svg", sc));
+                }
+                files.push((
+                    "error_by_speed.svg",
+                    length_eval::speed_plot(&runs, lodo_pred, model),
+                ));
+                for (name, svg) in files {
+                    let p = dir.join(name);
+                    std::fs::write(&p, svg).with_context(|| format!("writing {}", p.display()))?;
+                    eprintln!("wrote {}", p.display());
                 }
             }
         }
@@ -395,9 +445,10 @@ fn run(cli: Cli) -> anyhow::Result<()> {
             std::fs::write(&out, train::rust_source(&t))
                 .with_context(|| format!("writing {}", out.display()))?;
             eprintln!(
-                "trained on {} strides of {} trials; wrote {}",
+                "trained on {} strides of {} trials; best leave-one-dataset-out (the default): {}; wrote {}",
                 t.trained.samples,
                 t.trials,
+                t.default_model.name(),
                 out.display()
             );
         }
@@ -420,6 +471,9 @@ fn run(cli: Cli) -> anyhow::Result<()> {
         }
         Cmd::Holes { datasets } => {
             print!("{}", gaitclip_host::hole_sweep::report(&datasets)?);
+        }
+        Cmd::ZuptSweep { datasets } => {
+            print!("{}", gaitclip_host::zupt_sweep::report(&datasets)?);
         }
         Cmd::Simulate { out } => {
             fixtures::write_all(&out)?;

@@ -1,0 +1,172 @@
+//! `gaitclip zupt-sweep`: what the ZUPT stride's two physical settings do to its length, so
+//! that they are documented by measurement.
+//!
+//! - **Sensor height** above the foot's rolling contact ([`gaitclip::pipeline::Config`]'s
+//!   `sensor_height_um`, default [`gaitclip::cycle::SENSOR_HEIGHT_UM`]): at the stance
+//!   instant the foot rolls and the sensor moves at `ω × (h·up)`; `h = 0` is the plain
+//!   zero-velocity update. A clip on the side of a shoe sits lower than one on the laces.
+//! - **Gyro full-scale range**: the recordings are converted to MPU6050 counts at ±2000,
+//!   ±500 and ±250 °/s; at the lower ranges the swing's pitch rate clips and the tilt the
+//!   rails lost is put back ([`gaitclip::zupt::ZuptIntegrator::displacement_restoring_tilt`]),
+//!   reported for clipped and unclipped strides apart.
+//!
+//! Scored as `gaitclip eval` scores the `zupt` model: the cycle detector's valid strides
+//! matched to clean reference strides of `gaitmap_walk` and `pyshoe_vicon` (unscored spans,
+//! and references holding a movement the Vicon labels show unbordered, left out), error =
+//! ZUPT length − reference, binned by the reference stride's speed.
+
+use std::fmt::Write as _;
+use std::path::Path;
+
+use anyhow::Result;
+use gaitclip::models::Model;
+use gaitclip::sample::{AccelRange, GyroRange};
+use gaitclip::stride::StrideFlags;
+
+use crate::eval::{self, Detected, Scored};
+use crate::length_eval::SPEED_BINS;
+use crate::trace::Ranges;
+use crate::{csv_trace, replay};
+
+/// Sensor heights swept, mm.
+pub const HEIGHTS_MM: [u32; 6] = [0, 40, 60, 80, 100, 120];
+
+/// One scored stride: reference speed (m/s), error (m), clipped gyro.
+type Scoredstride = (f64, f64, bool);
+
+/// The ZUPT errors of one dataset at one height and range.
+fn errors(dataset: &eval::Dataset, ranges: Ranges, height_um: u32) -> Result<Vec<Scoredstride>> {
+    let mut out = Vec::new();
+    for trial in &dataset.trials {
+        let t = csv_trace::read(&trial.csv, Some(dataset.rate_hz))?;
+        let p = replay::prepare(&t, ranges)?;
+        let mut c = p.config(ranges);
+        c.model = Model::Zupt;
+        c.sensor_height_um = height_um;
+        let strides = p.strides(c);
+        let det: Vec<Detected> = strides.iter().map(Detected::from).collect();
+        let refs = trial.references_in_numbers(&p.clock);
+        let rate = p.clock.rate_hz();
+        let scored = eval::classify(trial, &p.clock, &det, &refs);
+        // As training scores: a reference holding a movement its borders leave out measured
+        // two movements, and no stride is compared with it.
+        let holds_two = |r: &eval::Reference| {
+            det.iter().zip(&scored).any(|(d, c)| {
+                *c == Scored::Unbordered
+                    && 2 * (d.foot_flat.min(r.end)).saturating_sub(d.heel_off.max(r.start))
+                        >= d.foot_flat - d.heel_off
+            })
+        };
+        for (i, c) in scored.iter().enumerate() {
+            let Scored::Found(j) = *c else { continue };
+            let (s, r) = (&strides[i], &refs[j]);
+            if !s.flags.valid() || holds_two(r) {
+                continue;
+            }
+            let Some(len) = r.length_m else { continue };
+            let speed = len / ((r.end - r.start) as f64 / rate);
+            out.push((
+                speed,
+                s.zupt_um as f64 / 1e6 - len,
+                s.flags.has(StrideFlags::GYRO_CLIPPED),
+            ));
+        }
+    }
+    Ok(out)
+}
+
+/// `n, RMSE / bias cm` of `e`, or `–`.
+fn cell(e: &[f64]) -> String {
+    if e.is_empty() {
+        return "–".into();
+    }
+    let n = e.len() as f64;
+    let rmse = (e.iter().map(|x| x * x).sum::<f64>() / n).sqrt();
+    let bias = e.iter().sum::<f64>() / n;
+    format!("{:.1} / {:+.1} ({})", rmse * 100.0, bias * 100.0, e.len())
+}
+
+/// The two tables, Markdown.
+pub fn report(root: &Path) -> Result<String> {
+    let mut s = String::new();
+    let sets: Vec<eval::Dataset> = ["gaitmap_walk", "pyshoe_vicon"]
+        .iter()
+        .map(|n| eval::load(&root.join(n)))
+        .collect::<Result<_>>()?;
+    let bin_name = |(lo, hi): (f64, f64)| {
+        if hi.is_infinite() {
+            format!("> {lo} m/s")
+        } else if lo == 0.0 {
+            format!("< {hi} m/s")
+        } else {
+            format!("{lo}–{hi} m/s")
+        }
+    };
+    writeln!(
+        s,
+        "ZUPT stride by sensor height above the rolling contact (cycle detector, ±2000 °/s; RMSE / bias cm (strides)):\n"
+    )?;
+    write!(s, "| height |")?;
+    for d in &sets {
+        write!(s, " {} all |", d.name)?;
+        for b in SPEED_BINS.iter().take(4) {
+            write!(s, " {} {} |", d.name, bin_name(*b))?;
+        }
+    }
+    writeln!(s)?;
+    writeln!(s, "|---|{}", "---|".repeat(sets.len() * 5))?;
+    for h in HEIGHTS_MM {
+        write!(s, "| {h} mm |")?;
+        for d in &sets {
+            let e = errors(d, Ranges::default(), h * 1000)?;
+            let all: Vec<f64> = e.iter().map(|x| x.1).collect();
+            write!(s, " {} |", cell(&all))?;
+            for (lo, hi) in SPEED_BINS.iter().take(4).copied() {
+                let b: Vec<f64> = e
+                    .iter()
+                    .filter(|x| x.0 >= lo && x.0 < hi)
+                    .map(|x| x.1)
+                    .collect();
+                write!(s, " {} |", cell(&b))?;
+            }
+        }
+        writeln!(s)?;
+    }
+    writeln!(
+        s,
+        "\nZUPT stride by gyro full-scale range (cycle detector, sensor height {} mm; RMSE / bias cm (strides)):\n",
+        gaitclip::cycle::SENSOR_HEIGHT_UM / 1000
+    )?;
+    write!(s, "| gyro range |")?;
+    for d in &sets {
+        write!(s, " {0} all | {0} clipped | {0} not clipped |", d.name)?;
+    }
+    writeln!(s)?;
+    writeln!(s, "|---|{}", "---|".repeat(sets.len() * 3))?;
+    for (gyro, label) in [
+        (GyroRange::Dps2000, "±2000 °/s"),
+        (GyroRange::Dps500, "±500 °/s"),
+        (GyroRange::Dps250, "±250 °/s"),
+    ] {
+        let ranges = Ranges {
+            accel: AccelRange::G16,
+            gyro,
+        };
+        write!(s, "| {label} |")?;
+        for d in &sets {
+            let e = errors(d, ranges, gaitclip::cycle::SENSOR_HEIGHT_UM)?;
+            let pick = |f: &dyn Fn(&Scoredstride) -> bool| -> Vec<f64> {
+                e.iter().filter(|x| f(x)).map(|x| x.1).collect()
+            };
+            write!(
+                s,
+                " {} | {} | {} |",
+                cell(&pick(&|_| true)),
+                cell(&pick(&|x| x.2)),
+                cell(&pick(&|x| !x.2))
+            )?;
+        }
+        writeln!(s)?;
+    }
+    Ok(s)
+}

@@ -1,0 +1,88 @@
+//! The cycle detector's fixed-point strides against their `f64` twin
+//! ([`gaitclip_host::cycle_ref`]): every stride of every trial of the three datasets, at the
+//! MPU6050's widest ranges and at ±250 °/s (where nearly every stride clips and the tilt
+//! is put back on the clipped samples), within 1 mm of the twin.
+
+use gaitclip::sample::{AccelRange, GyroRange};
+use gaitclip_host::cycle_ref::{self, Skipped};
+use gaitclip_host::datasets::root_or_skip;
+use gaitclip_host::trace::Ranges;
+use gaitclip_host::{csv_trace, eval, replay};
+
+#[test]
+fn cycle_strides_match_the_f64_twin_within_1_mm() {
+    let Some(root) = root_or_skip("cycle_strides_match_the_f64_twin_within_1_mm") else {
+        return;
+    };
+    let widest = Ranges::default();
+    let clipping = Ranges {
+        accel: AccelRange::G16,
+        gyro: GyroRange::Dps250,
+    };
+    for (name, ranges) in [
+        ("gaitmap_walk", widest),
+        ("pyshoe_vicon", widest),
+        ("ipol_gait_events", widest),
+        ("gaitmap_walk", clipping),
+        ("pyshoe_vicon", clipping),
+    ] {
+        let d = eval::load(&root.join(name)).unwrap();
+        let (mut measured, mut valid, mut worst, mut clipped) = (0usize, 0usize, 0f64, 0usize);
+        let mut skipped = [0usize; 4];
+        for trial in &d.trials {
+            let t = csv_trace::read(&trial.csv, Some(d.rate_hz)).unwrap();
+            let p = replay::prepare(&t, ranges).unwrap();
+            let run = cycle_ref::run(&p.counts, &p.clock.holes, p.config(ranges));
+            for (k, s) in run.strides.iter().enumerate() {
+                if s.flags.valid() {
+                    valid += 1;
+                }
+                match cycle_ref::zupt_m(&run, k) {
+                    Ok(m) => {
+                        let e = (s.zupt_um as f64 / 1e6 - m).abs();
+                        assert!(
+                            e <= 1e-3,
+                            "{name} {} stride {k} ({}..{}): core {} µm, f64 {:.0} µm",
+                            trial.name,
+                            s.start,
+                            s.end,
+                            s.zupt_um,
+                            m * 1e6
+                        );
+                        worst = worst.max(e);
+                        measured += 1;
+                        if s.flags.has(gaitclip::stride::StrideFlags::GYRO_CLIPPED) {
+                            clipped += 1;
+                        }
+                    }
+                    Err(why) => {
+                        skipped[match why {
+                            Skipped::Flagged => 0,
+                            Skipped::NoPrevious => 1,
+                            Skipped::Missing => 2,
+                            Skipped::LongRest => 3,
+                        }] += 1
+                    }
+                }
+            }
+        }
+        eprintln!(
+            "{name} at {:?}: {measured} of {valid} valid strides measured ({clipped} clipped), \
+             worst {:.3} mm; skipped: flagged {}, first after a rest {}, missing {}, long rest {}",
+            ranges.gyro,
+            worst * 1e3,
+            skipped[0],
+            skipped[1],
+            skipped[2],
+            skipped[3]
+        );
+        // The twin measures the strides that matter: every stride but the first of a walk.
+        assert!(
+            measured as f64 >= 0.85 * valid as f64,
+            "{name}: only {measured} of {valid} valid strides measured"
+        );
+        if ranges.gyro == GyroRange::Dps250 {
+            assert!(clipped * 2 >= measured, "{name}: {clipped} clipped strides");
+        }
+    }
+}
