@@ -896,8 +896,12 @@ impl<const M: usize> Pipeline<M> {
             return;
         }
         // The ZUPT model, the fallback, needs no statistics: empty ones if they were gone.
-        let stats = self.stats(s).unwrap_or(&StrideStats::EMPTY);
-        let f = Features::of(s, stats, self.rate);
+        let f = if self.model == Model::Zupt {
+            Features::zupt_only(s)
+        } else {
+            let stats = self.stats(s).unwrap_or(&StrideStats::EMPTY);
+            Features::of(s, stats, self.rate)
+        };
         let mm = models::predict_mm(self.model, &f, self.settings, self.params)
             .or_else(|| models::predict_mm(Model::Zupt, &f, self.settings, self.params))
             .unwrap_or(0);

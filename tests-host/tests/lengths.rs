@@ -310,3 +310,31 @@ fn zhang_fit_on_the_papers_table_1() {
         assert!((got - exact).abs() < 1e-3, "{got} vs {exact}");
     }
 }
+
+/// The pipeline's shortcut for the `zupt` model (`Features::zupt_only`, which skips the
+/// other 105 features) gives the length the full features give, on every demo stride.
+#[test]
+fn the_zupt_shortcut_gives_the_full_features_length() {
+    use gaitclip::features::Features;
+    use gaitclip::models::{predict_mm, Model, Settings};
+    let counts = gaitclip_host::fixtures::firmware_trace_counts().unwrap();
+    let rate = gaitclip::rate::SampleRate::from_hz(200).unwrap();
+    let ranges = gaitclip_host::trace::Ranges::default();
+    let config = gaitclip::pipeline::Config::new(rate, ranges.accel, ranges.gyro);
+    let (strides, _) = gaitclip_host::replay::core_run_with_stats(&counts, &[], config);
+    assert!(strides.len() >= 20);
+    let p = &gaitclip::trained::PARAMS;
+    for (s, stats) in &strides {
+        let full = predict_mm(
+            Model::Zupt,
+            &Features::of(s, stats, rate),
+            Settings::DEFAULT,
+            p,
+        );
+        let short = predict_mm(Model::Zupt, &Features::zupt_only(s), Settings::DEFAULT, p);
+        assert_eq!(full, short, "{s:?}");
+        if s.flags.valid() {
+            assert_eq!(short, Some(s.length_mm), "{s:?}");
+        }
+    }
+}
