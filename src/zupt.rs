@@ -364,9 +364,12 @@ impl ZuptIntegrator {
             div_round_i128(p2 * G_UM_PER_S2_X1E6, den)
         };
         let clamp = |v: i128| v.clamp(-(1 << 40), 1 << 40) as i64;
-        let (x, y) = (clamp(um(0)), clamp(um(1)));
+        // Horizontally ±2³¹ µm (2 km, far beyond any stride): the sum of squares then fits
+        // a u64 (≤ 2⁶³) whatever a hostile input integrated to.
+        let horizontal = |v: i128| v.clamp(-(1 << 31), 1 << 31).unsigned_abs() as u64;
+        let (x, y) = (horizontal(um(0)), horizontal(um(1)));
         Displacement {
-            horizontal_um: isqrt_u64((x * x + y * y) as u64),
+            horizontal_um: isqrt_u64(x * x + y * y),
             vertical_um: clamp(um(2)),
         }
     }
