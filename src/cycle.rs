@@ -793,7 +793,10 @@ impl<const M: usize> CycleDetector<M> {
             flags |= StrideFlags::TOO_LONG;
         }
         let len = c.movement_len.min(movement.len());
-        let heel_off = cur.heel_off.unwrap_or(c.foot_flat);
+        // A candidate in the low stretch the stride started in (a rest): its foot-flat is
+        // the stride's start, not the stretch's.
+        let foot_flat = c.foot_flat.max(cur.start);
+        let heel_off = cur.heel_off.unwrap_or(foot_flat).max(cur.start);
         let index = *next_index;
         *next_index = next_index.wrapping_add(1);
         // The statistics go straight into their slot (≈ 400 B, not through the stack).
@@ -832,7 +835,6 @@ impl<const M: usize> CycleDetector<M> {
             (None, _) => (heel_off, heel_off),
         };
         // Events in order whatever the buffer held.
-        let foot_flat = c.foot_flat;
         let heel_strike = heel_strike.min(foot_flat).max(heel_off);
         let toe_off = toe_off.min(heel_strike).max(heel_off);
         let d_ok = cur.broken.is_none();
