@@ -148,17 +148,10 @@ impl ZuptIntegrator {
         if self.gravity_q8 == 0 {
             return false;
         }
-        self.attitude = level;
-        self.start_attitude = level;
-        self.gyro_bias = gyro_sum.map(|s| div_round_i128(s as i128, n as i128) as i32);
-        self.velocity_q8 = [0; 3];
-        self.position_x2_q8 = [0; 3];
-        self.samples = 0;
-        self.clipped = 0;
-        self.clipped_c = 0;
-        self.clipped_c2 = 0;
-        self.rail_runs = [RailRun::NEW; 3];
-        true
+        let gyro_bias = gyro_sum.map(|s| div_round_i128(s as i128, n as i128) as i32);
+        // At rest: no velocity to impose.
+        let gravity_q8 = self.gravity_q8;
+        self.start_at(level, gyro_bias, gravity_q8, [0; 3])
     }
 
     /// Starts a stride at a stance instant from what is known there: the attitude `level`
