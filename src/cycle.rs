@@ -24,7 +24,7 @@
 //! [`CONFIRM_MS`] have passed without a candidate [`SUPERSEDE_MILLIDECADES`] deeper (a slow
 //! swing dips in the middle; the stance after it is far stiller). At rest (energy under
 //! [`REST_Q16`]) a later instant is as good as a stiller one: the stance instant follows the
-//! rest, and a stance that lasts [`MAX_STANCE_MS`] ends the stride before it (the last step
+//! rest, and a stance that lasts [`MAX_STANCE_IN_STRIDE_MS`] ends the stride before it (the last step
 //! before standing).
 //!
 //! **The stride.** A strapdown integrator ([`ZuptIntegrator`]) starts at each candidate:

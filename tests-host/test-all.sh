@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # Runs every check of gaitclip, as CI does: formatting and clippy (-D warnings) in every
-# workspace, firmware builds for both Cortex-M targets and every board (nRF52840-DK,
-# Raspberry Pi Pico, QEMU micro:bit), and the host test suite (driver transactions, fixed
+# workspace, the core's and the board glue's unit tests and docs on the host, release builds
+# of every board (QEMU mps2-an386 and micro:bit, nRF52840-DK, Raspberry Pi Pico) and of the
+# benchmark for both Cortex-M targets, and the host test suite (driver transactions, fixed
 # point vs f64, fixtures, MCAP/CSV readers and the MCAP conformance files, bus faults, gaps,
 # jitter and saturation, property tests, the fuzz corpus and regressions, real datasets when
 # ../shared/datasets is present, the bit-exact QEMU runs of the M4 and M0 firmware, and the instruction counts of
@@ -21,23 +22,22 @@ bash "$root/boards/install-qemu"
 # The boards link through flip-link (stack-overflow protection); cargo installs it.
 command -v flip-link >/dev/null 2>&1 || cargo install --locked flip-link
 
-echo "== firmware crate: rustfmt, clippy, builds (thumbv7em-none-eabihf, thumbv6m-none-eabi)"
-cargo fmt --check
-cargo clippy --release -- -D warnings
-cargo clippy --release --lib --target thumbv6m-none-eabi -- -D warnings
-cargo build --release
-cargo build --release --lib --target thumbv6m-none-eabi
+echo "== core library and board glue on the host: rustfmt, clippy, unit tests, docs"
+cargo fmt --all --check
+cargo clippy --all-targets -- -D warnings
+log=$(mktemp)
+cargo test 2>&1 | tee "$log"
+RUSTDOCFLAGS="-D warnings" cargo doc --no-deps
 
-echo "== boards: rustfmt, clippy, release builds (nrf52840-dk, rp-pico, microbit)"
-for board in nrf52840-dk rp-pico microbit; do
-  (cd "$root/boards/$board" && cargo fmt --check && cargo clippy --release -- -D warnings && cargo build --release)
+echo "== firmware: clippy and release builds of every board (each for its target) and the benchmark (both)"
+for pkg in mps2-an386:thumbv7em-none-eabihf microbit:thumbv6m-none-eabi \
+  nrf52840-dk:thumbv7em-none-eabihf rp-pico:thumbv6m-none-eabi \
+  bench:thumbv7em-none-eabihf bench:thumbv6m-none-eabi; do
+  p="gaitclip-${pkg%%:*}" t=${pkg#*:}
+  cargo clippy --release -p "$p" --target "$t" -- -D warnings
+  cargo build --release -p "$p" --target "$t"
 done
-
-echo "== benchmark firmware (boards/bench): rustfmt, clippy, builds for both targets"
-(cd "$root/boards/bench" && cargo fmt --check &&
-  for t in thumbv7em-none-eabihf thumbv6m-none-eabi; do
-    cargo clippy --release --target "$t" -- -D warnings && cargo build --release --target "$t"
-  done)
+cargo clippy --release -p gaitclip --target thumbv6m-none-eabi -- -D warnings
 
 echo "== tests-host (and the qemu-insn-count plugin): rustfmt, clippy, tests"
 cd "$root/tests-host"
@@ -46,8 +46,7 @@ cargo fmt --check
 # bodies are in src/fuzzing.rs and their corpus is replayed by tests/fuzz_corpus.rs below.
 cargo fmt --check --manifest-path fuzz/Cargo.toml
 cargo clippy --workspace --all-targets -- -D warnings
-log=$(mktemp)
-cargo test --workspace 2>&1 | tee "$log"
+cargo test --workspace 2>&1 | tee -a "$log"
 # One closing line over every test binary.
 awk '/^test result:/ { for (i = 1; i <= NF; i++) { if ($(i) ~ /^passed/) p += $(i-1); if ($(i) ~ /^failed/) f += $(i-1) } }
      END { printf "tests: %d passed, %d failed\n", p, f }' "$log"

@@ -12,7 +12,7 @@ fn main() {
     let memory = if armv6m {
         "../microbit/memory.x"
     } else {
-        "../../memory.x"
+        "../mps2-an386/memory.x"
     };
     fs::copy(memory, out.join("memory.x")).expect("the board's memory.x");
     println!("cargo:rustc-link-search={}", out.display());

@@ -9,32 +9,8 @@
 #![no_main]
 
 mod nrf51_timer;
-// The shared board glue: not every board uses every part of it.
-#[allow(dead_code)]
-#[path = "../common/imu_sampler.rs"]
-mod imu_sampler;
-#[allow(dead_code)]
-#[path = "../common/live_app.rs"]
-mod live_app;
-#[path = "../common/replay_app.rs"]
-mod replay_app;
-#[cfg(feature = "replay-holes")]
-#[path = "../common/replay_holes.rs"]
-mod replay_holes;
-#[path = "../common/replay_mpu6050.rs"]
-mod replay_mpu6050;
-#[allow(dead_code)]
-#[path = "../common/serial_line.rs"]
-mod serial_line;
-#[path = "../common/stack_paint.rs"]
-mod stack_paint;
-#[allow(dead_code)]
-#[path = "../common/startup.rs"]
-mod startup;
-#[path = "../common/stride_log.rs"]
-mod stride_log;
-#[path = "../../fixtures/demo_walk.rs"]
-mod trace;
+
+use gaitclip_board::replay_app;
 
 use cortex_m::peripheral::NVIC;
 use cortex_m_rt::{entry, exception};

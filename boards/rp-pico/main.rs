@@ -15,22 +15,7 @@
 #![no_std]
 #![no_main]
 
-// The shared board glue: not every board uses every part of it.
-#[allow(dead_code)]
-#[path = "../common/imu_sampler.rs"]
-mod imu_sampler;
-#[allow(dead_code)]
-#[path = "../common/live_app.rs"]
-mod live_app;
-#[allow(dead_code)]
-#[path = "../common/serial_line.rs"]
-mod serial_line;
-#[allow(dead_code)]
-#[path = "../common/startup.rs"]
-mod startup;
-#[allow(dead_code)]
-#[path = "../common/stride_log.rs"]
-mod stride_log;
+use gaitclip_board::{imu_sampler, live_app, startup, stride_log};
 
 use core::cell::RefCell;
 

@@ -466,7 +466,7 @@ pub struct Build {
 pub const BUILDS: [Build; 6] = [
     Build {
         label: "mps2-an386 (QEMU, M4F)",
-        dir: ".",
+        dir: "boards/mps2-an386",
         bin: "mps2-an386",
         target: "thumbv7em-none-eabihf",
         machine: Some(qemu::MACHINE_M4),
@@ -474,7 +474,7 @@ pub const BUILDS: [Build; 6] = [
     },
     Build {
         label: "mps2-an386 (QEMU, M4F), peak-valley detector",
-        dir: ".",
+        dir: "boards/mps2-an386",
         bin: "mps2-an386",
         target: "thumbv7em-none-eabihf",
         machine: Some(qemu::MACHINE_M4),

@@ -1,25 +1,25 @@
-//! Builds the firmware of the top-level crate and parses its stride log, for tests that
-//! compare it with the host replay.
+//! Builds a board's firmware (a package of the root workspace, under `boards/`) and parses its
+//! stride log, for tests that compare it with the host replay.
 
 use std::path::{Path, PathBuf};
 use std::process::Command;
 
 use anyhow::{bail, Context};
 
-/// The repository root (the firmware crate).
+/// The repository root (the core library and the firmware's workspace).
 pub fn repo_root() -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR")).join("..")
 }
 
-/// Builds `bin` for `target` in release mode from the package in `dir` (relative to the
-/// repository root: `.` for the top-level crate, `boards/microbit` for a board with its own
-/// workspace) and returns the ELF path.
+/// Builds `bin` for `target` in release mode from the board package in `dir` (relative to the
+/// repository root: `boards/mps2-an386`, `boards/bench`, …) and returns the ELF path.
 pub fn build_in(dir: &str, bin: &str, target: &str) -> anyhow::Result<PathBuf> {
     build_with(dir, bin, target, &[], &[])
 }
 
 /// [`build_in`] with extra cargo arguments (`--features …`) and environment variables (a
-/// `CARGO_TARGET_DIR` among them, relative to `dir`, keeps a variant's ELF apart).
+/// `CARGO_TARGET_DIR` among them, relative to the repository root, keeps a variant's ELF
+/// apart from the workspace's `target/`).
 pub fn build_with(
     dir: &str,
     bin: &str,
@@ -27,25 +27,31 @@ pub fn build_with(
     args: &[&str],
     env: &[(&str, &std::ffi::OsStr)],
 ) -> anyhow::Result<PathBuf> {
-    let root = repo_root().join(dir);
+    let root = repo_root();
+    let target_dir = env
+        .iter()
+        .find(|(k, _)| *k == "CARGO_TARGET_DIR")
+        .map_or_else(|| root.join("target"), |(_, v)| root.join(v));
     let status = Command::new(std::env::var("CARGO").unwrap_or_else(|_| "cargo".into()))
-        .current_dir(&root)
+        .current_dir(root.join(dir))
         .env_remove("CARGO_BUILD_TARGET")
         .env_remove("RUSTFLAGS")
         .env_remove("CARGO_ENCODED_RUSTFLAGS")
         .env_remove("CARGO_TARGET_DIR")
-        .envs(env.iter().copied())
+        .envs(
+            env.iter()
+                .copied()
+                .filter(|(k, _)| *k != "CARGO_TARGET_DIR"),
+        )
         .args(["build", "--release", "--bin", bin, "--target", target])
+        .arg("--target-dir")
+        .arg(&target_dir)
         .args(args)
         .status()
         .context("running cargo build for the firmware")?;
     if !status.success() {
         bail!("firmware build failed ({status})");
     }
-    let target_dir = env
-        .iter()
-        .find(|(k, _)| *k == "CARGO_TARGET_DIR")
-        .map_or_else(|| root.join("target"), |(_, v)| root.join(v));
     Ok(target_dir.join(target).join("release").join(bin))
 }
 
@@ -75,11 +81,6 @@ pub fn build_for(
             build_with(dir, bin, target, &["--features", PEAK_VALLEY_FEATURE], &env)
         }
     }
-}
-
-/// Builds `bin` of the top-level crate for `target`; see [`build_in`].
-pub fn build(bin: &str, target: &str) -> anyhow::Result<PathBuf> {
-    build_in(".", bin, target)
 }
 
 /// The integers of one `stride …` log line.

@@ -1,25 +1,13 @@
 //! The board glue shared by every firmware, on the host: the sampler's retries, restarts and
 //! gap accounting over a bus that fails, the serial line protocol, and the start-up reports.
 
-#[path = "../../boards/common/imu_sampler.rs"]
-#[allow(dead_code)]
-mod imu_sampler;
-#[path = "../../boards/common/replay_mpu6050.rs"]
-#[allow(dead_code)]
-mod replay_mpu6050;
-#[path = "../../boards/common/serial_line.rs"]
-#[allow(dead_code)]
-mod serial_line;
-#[path = "../../boards/common/startup.rs"]
-#[allow(dead_code)]
-mod startup;
-
 use embedded_hal::i2c::{ErrorType, I2c, Operation};
 use embedded_hal_mock::eh1::delay::NoopDelay;
 use gaitclip::mpu6050::{Address, Config, Mpu6050, OutputRate};
 use gaitclip::pipeline::Pipeline;
 use gaitclip::rate::SampleRate;
 use gaitclip::sample::{GyroRange, RawSample};
+use gaitclip_board::{imu_sampler, replay_mpu6050, serial_line, startup};
 use imu_sampler::{BusRecovery, Counters, ImuSampler, Item, ReadMode};
 use replay_mpu6050::{ReplayBusError, ReplayMpu6050};
 

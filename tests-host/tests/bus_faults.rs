@@ -5,10 +5,6 @@
 //! pipeline reports the stride across the outage as invalid (a gap stride) and resumes: the
 //! strides before it are unchanged, the ones after it all found. No panic anywhere.
 
-#[path = "../../boards/common/imu_sampler.rs"]
-#[allow(dead_code)]
-mod imu_sampler;
-
 use embedded_hal::i2c::{ErrorKind, ErrorType, I2c, NoAcknowledgeSource, Operation};
 use embedded_hal_mock::eh1::delay::NoopDelay;
 use embedded_hal_mock::eh1::i2c::{Mock, Transaction as T};
@@ -17,6 +13,7 @@ use gaitclip::pipeline::{self, Pipeline};
 use gaitclip::rate::SampleRate;
 use gaitclip::sample::{AccelRange, GyroRange};
 use gaitclip::stride::{Stride, StrideFlags};
+use gaitclip_board::imu_sampler;
 use imu_sampler::{BusRecovery, Counters, ImuSampler, Item, ReadMode, RESTART_AFTER, RETRIES};
 
 // Register map (MPU-6000/6050 Register Map rev. 4.2), not imported from the driver.

@@ -1,16 +1,10 @@
 //! The emulated MPU6050 of the QEMU board, driven by the real driver on the host: it serves
 //! the fixture sample by sample and ends with the trace.
 
-#[path = "../../boards/common/imu_sampler.rs"]
-#[allow(dead_code)]
-mod imu_sampler;
-#[path = "../../boards/common/replay_mpu6050.rs"]
-#[allow(dead_code)]
-mod replay_mpu6050;
-
 use embedded_hal_mock::eh1::delay::NoopDelay;
 use gaitclip::mpu6050::{Address, Config, Error, Mpu6050, OutputRate};
 use gaitclip::sample::RawSample;
+use gaitclip_board::replay_mpu6050;
 use replay_mpu6050::{ReplayBusError, ReplayMpu6050};
 
 #[test]

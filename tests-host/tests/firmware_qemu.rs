@@ -7,6 +7,7 @@ use gaitclip::pipeline::{Config, Detector};
 use gaitclip::rate::SampleRate;
 use gaitclip::sample::RawSample;
 use gaitclip::stride::{Stride, StrideFlags};
+use gaitclip_board::replay_holes;
 use gaitclip_host::clock::Gap;
 use gaitclip_host::firmware::{self, parse_stride_line, LoggedStride};
 use gaitclip_host::qemu::{self, RunOptions};
@@ -15,9 +16,6 @@ use gaitclip_host::trace::Ranges;
 
 /// The movement buffer of the micro:bit firmware (`boards/microbit/main.rs`).
 const MICROBIT_MOVEMENT_SAMPLES: usize = 256;
-
-#[path = "../../boards/common/replay_holes.rs"]
-mod replay_holes;
 
 fn logged(s: &Stride) -> LoggedStride {
     LoggedStride {
@@ -144,7 +142,7 @@ fn qemu_m0_bridges_holes_as_the_host_replay() {
 #[test]
 fn qemu_m4_strides_equal_host_replay() {
     strides_equal_host_replay(
-        ".",
+        "boards/mps2-an386",
         "mps2-an386",
         "thumbv7em-none-eabihf",
         qemu::MACHINE_M4,

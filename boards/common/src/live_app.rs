@@ -58,6 +58,16 @@ pub struct SampleLink<I, D> {
     pulses: AtomicU32,
 }
 
+impl<I, D> Default for SampleLink<I, D>
+where
+    I: I2c + BusRecovery,
+    D: DelayNs,
+{
+    fn default() -> Self {
+        Self::new()
+    }
+}
+
 impl<I, D> SampleLink<I, D>
 where
     I: I2c + BusRecovery,

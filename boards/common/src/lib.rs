@@ -1,0 +1,43 @@
+//! # gaitclip-board — what every gaitclip firmware shares
+//!
+//! A board is a `main.rs` that wires its peripherals (I²C, the INT pin or a timer, a UART) to
+//! the parts here and keeps the [`gaitclip::pipeline::Pipeline`] in a static sized for its
+//! RAM; everything between the sensor's registers and the log lines lives in this crate:
+//!
+//! - [`imu_sampler`]: the interrupt side, one data-ready pulse → one sample (or a FIFO
+//!   burst) into an SPSC queue, bus errors counted and retried, lost samples declared as
+//!   gaps.
+//! - [`startup`]: what the user is told while the core calibrates itself.
+//! - [`serial_line`]: the line protocol of the UART output.
+//! - [`replay_mpu6050`] and [`replay_holes`]: an MPU6050 on an emulated I²C bus serving a
+//!   stored trace, for the QEMU boards and the host tests.
+//! - On a Cortex-M only: `live_app` (the main loop of a board with a real sensor),
+//!   `stride_log` (defmt and the serial line), and with the `replay` feature
+//!   `replay_app` (the QEMU firmware) and `stack_paint` (the stack's high-water mark).
+//!
+//! The parts above `live_app` build on the host, where `tests-host` checks them against
+//! mocked buses.
+
+#![no_std]
+#![deny(missing_docs)]
+
+pub mod imu_sampler;
+pub mod replay_holes;
+pub mod replay_mpu6050;
+pub mod serial_line;
+pub mod startup;
+
+#[cfg(target_os = "none")]
+pub mod live_app;
+#[cfg(all(target_os = "none", feature = "replay"))]
+pub mod replay_app;
+#[cfg(all(target_os = "none", feature = "replay"))]
+pub mod stack_paint;
+#[cfg(target_os = "none")]
+pub mod stride_log;
+
+/// The simulated demo walk the QEMU boards replay (`fixtures/demo_walk.rs`, written by
+/// `gaitclip fixtures`).
+#[cfg(all(target_os = "none", feature = "replay"))]
+#[path = "../../../fixtures/demo_walk.rs"]
+pub mod trace;
