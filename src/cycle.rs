@@ -47,9 +47,12 @@
 
 use heapless::Vec;
 
+use crate::detector::{Drain, Input, StepDetector};
 use crate::fixed::{isqrt_u64, QuatQ30};
+use crate::foot_frame::{FootFrameEstimator, FOOT_LSB_PER_G};
 use crate::phase_stats::{StrideStats, CHANNELS};
 use crate::phases::{self, PhaseMethod};
+use crate::pipeline::Config;
 use crate::rate::SampleRate;
 use crate::sample::{AccelRange, GyroRange, RawSample};
 use crate::stride::{magnitude_minus_g, Origin, Stride, StrideFlags, MAX_STANCE_IN_STRIDE_MS};
@@ -199,6 +202,25 @@ pub struct Calibration {
     pub up: [i32; 3],
 }
 
+impl Calibration {
+    /// What the detector judges the newest decision with: gyro bias and gravity from the
+    /// steadiest still blocks ([`FootFrameEstimator::still_calibration`]), or the foot
+    /// frame's rest before the first block qualifies, and the foot's standing up. `None`
+    /// before the foot frame exists.
+    pub fn of(frame: &FootFrameEstimator, accel_lsb_per_g: i32) -> Option<Calibration> {
+        let f = frame.frame()?;
+        let (gyro_bias, gravity_counts) = frame.still_calibration().unwrap_or((
+            frame.gyro_bias(),
+            f.gravity() * accel_lsb_per_g / FOOT_LSB_PER_G,
+        ));
+        Some(Calibration {
+            gyro_bias,
+            gravity_counts,
+            up: f.up_row(),
+        })
+    }
+}
+
 /// The candidate stance.
 #[derive(Clone, Copy, Debug)]
 struct Candidate {
@@ -287,6 +309,8 @@ pub struct CycleDetector<const M: usize> {
     last_at: u32,
     /// Phase statistics of the last two strides, by index parity.
     stats: [(u32, StrideStats); 2],
+    /// A stride released while filling a hole with no call to report it from.
+    held: Option<Stride>,
     dropped: u32,
 }
 
@@ -296,8 +320,19 @@ const fn per_window(q16: u64, w: u32) -> u64 {
 }
 
 impl<const M: usize> CycleDetector<M> {
+    /// The detector for data described by `config`.
+    pub const fn new(config: &Config) -> Self {
+        Self::with_config(CycleConfig::new(
+            config.rate,
+            config.accel,
+            config.gyro,
+            config.phases,
+            config.sensor_height_um,
+        ))
+    }
+
     /// A detector with no history.
-    pub const fn new(cfg: CycleConfig) -> Self {
+    pub const fn with_config(cfg: CycleConfig) -> Self {
         CycleDetector {
             cfg,
             ring: [0; ENERGY_CAPACITY],
@@ -322,6 +357,7 @@ impl<const M: usize> CycleDetector<M> {
                 (u32::MAX, StrideStats::EMPTY),
                 (u32::MAX, StrideStats::EMPTY),
             ],
+            held: None,
             dropped: 0,
         }
     }
@@ -928,4 +964,75 @@ fn agrees(q: &QuatQ30, mean: &[i64; 3]) -> bool {
     let lhs = (dot >> 30) * (dot >> 30);
     let rhs = (m2 * COS2_45_Q30) >> 30;
     lhs >= rhs
+}
+
+impl<const M: usize> StepDetector for CycleDetector<M> {
+    fn delay(&self, _filter_delay: u32) -> u32 {
+        self.cfg.half
+    }
+
+    fn process(&mut self, x: &Input<'_>, out: &mut Option<Stride>) {
+        if out.is_none() {
+            *out = self.held.take();
+        }
+        if x.since_reset <= self.cfg.half + x.filter_delay {
+            return;
+        }
+        // The decision is about the sample `delay` back; its mean-filtered foot-frame value
+        // was computed `filter delay` inputs after it.
+        let at = x.index.wrapping_sub(self.cfg.half);
+        let foot = x.lines.foot(at.wrapping_add(x.filter_delay));
+        let raw = x.lines.raw(at);
+        let Some(cal) = Calibration::of(x.frame, x.accel_lsb_per_g) else {
+            return;
+        };
+        if out.is_some() {
+            // Reported at the next call: this one has its stride.
+            let mut later = None;
+            self.process_into(
+                x.newest,
+                at,
+                &raw,
+                foot,
+                x.lines.origin(at),
+                &cal,
+                &mut later,
+            );
+            if let Some(s) = later {
+                self.hold(s);
+            }
+        } else {
+            self.process_into(x.newest, at, &raw, foot, x.lines.origin(at), &cal, out);
+        }
+    }
+
+    fn restart(&mut self, _: &Drain<'_>) -> Option<Stride> {
+        CycleDetector::gap(self);
+        self.held.take()
+    }
+
+    fn hold(&mut self, stride: Stride) {
+        if self.held.is_none() {
+            self.held = Some(stride);
+        } else {
+            self.dropped = self.dropped.saturating_add(1);
+        }
+    }
+
+    fn finish(&mut self, _: &Drain<'_>) -> Option<Stride> {
+        if let Some(s) = self.held.take() {
+            return Some(s);
+        }
+        let mut last = None;
+        CycleDetector::finish(self, &mut last);
+        last
+    }
+
+    fn stats(&self, index: u32) -> Option<&StrideStats> {
+        CycleDetector::stats(self, index)
+    }
+
+    fn dropped(&self) -> u32 {
+        self.dropped
+    }
 }

@@ -74,6 +74,7 @@
 
 pub mod bridge;
 pub mod cycle;
+pub mod detector;
 pub mod features;
 pub mod fixed;
 pub mod foot_frame;

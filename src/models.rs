@@ -34,7 +34,8 @@
 use crate::features::{self, Features, Q16_ONE};
 use crate::fixed::{div_round_i128, root_q16, tenth_root_q16};
 use crate::fuzzy;
-use crate::phase_stats::{Channel, Segment};
+use crate::phase_stats::{Channel, Segment, StrideStats};
+use crate::stride::{Stride, StrideFlags};
 use crate::svr::{Boosted, Svr};
 
 /// Number of models.
@@ -299,31 +300,41 @@ pub const fn um_to_mm(um: i64) -> u32 {
     }
 }
 
-/// Lu's whole chain on one of the peak-valley detector's steps
-/// ([`crate::pipeline::Detector::PeakValley`]), with the paper's constants and no training:
-/// `D` = peak − valley (eq. 11) and the step frequency `f` give the fuzzy `k` over the
-/// paper's universes ([`fuzzy::D_UNIVERSE_Q16`], [`fuzzy::F_UNIVERSE_Q16`]), and Weinberg's
-/// `k·(a_max − a_min)^¼` (eq. 6) is taken with the step's own peak and valley as `a_max`
-/// and `a_min`. Returns the foot's stride, µm.
-///
-/// On a foot the detector sees one peak-valley pair per stride of that foot, so the
-/// walker's step frequency is twice the pairs' (`f = 2·rate/period`), and the foot's
-/// stride is two of the walker's steps: the stride is `2·k·D^¼`. The first step of a walk
-/// has no period; it takes `f` at the bottom of the universe (1 Hz), as a walk starts slowly.
-pub fn lu_chain_um(step: &crate::peak_valley::Step, rate: crate::rate::SampleRate) -> i64 {
-    // D in g, Q16: the low-pass unit is g/32 768 = 2⁻¹⁵ g.
-    let d_q16 = (step.difference().max(0) as i64) << 1;
-    let f_q16 = if step.period == 0 {
-        fuzzy::F_UNIVERSE_Q16.0
-    } else {
-        // 2 · rate(mHz)/1000 / period, Hz, Q16.
-        div_round_i128(
-            2 * rate.millihertz() as i128 * Q16_ONE as i128,
-            1000 * step.period as i128,
-        ) as i64
-    };
-    let k = fuzzy::lu_k_q16(f_q16, fuzzy::F_UNIVERSE_Q16, d_q16, fuzzy::D_UNIVERSE_Q16);
-    let root = root_q16(d_q16 as u64, 4) as i64;
-    // 2 · k · D^¼, Q32 → µm.
-    div_round_i128(2 * k as i128 * root as i128 * 1_000_000, 1i128 << 32) as i64
+/// What fills in a stride's length: the configured model with its settings and trained
+/// parameters, and the ZUPT displacement, which needs no training, when that model cannot
+/// give one.
+#[derive(Clone, Copy, Debug)]
+pub struct LengthChain {
+    /// The model.
+    pub model: Model,
+    /// The wearer's settings.
+    pub settings: Settings,
+    /// Trained coefficients and SVRs.
+    pub params: &'static ModelParams<'static>,
+    /// Sample rate (the features' durations).
+    pub rate: crate::rate::SampleRate,
+}
+
+impl LengthChain {
+    /// Fills in `s`'s length from its features (`stats`: its phase statistics, if still
+    /// kept); a gap stride keeps none.
+    // Not inlined: the per-stride work stays out of the per-sample frame (stack), and
+    // `gaitclip cost` counts it apart from the sample path.
+    #[inline(never)]
+    pub fn measure(&self, s: &mut Stride, stats: Option<&StrideStats>) {
+        if s.flags.has(StrideFlags::GAP) {
+            // No length across a gap; `length_mm` stays 0.
+            return;
+        }
+        // The ZUPT model, the fallback, needs no statistics: empty ones if they were gone.
+        let f = if self.model == Model::Zupt {
+            Features::zupt_only(s)
+        } else {
+            Features::of(s, stats.unwrap_or(&StrideStats::EMPTY), self.rate)
+        };
+        let mm = predict_mm(self.model, &f, self.settings, self.params)
+            .or_else(|| predict_mm(Model::Zupt, &f, self.settings, self.params))
+            .unwrap_or(0);
+        s.set_length_mm(mm);
+    }
 }

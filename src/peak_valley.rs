@@ -59,8 +59,16 @@
 
 use heapless::Vec;
 
+use crate::detector::{Drain, Input, StepDetector};
+use crate::features::Q16_ONE;
+use crate::fixed::{div_round_i128, root_q16};
+use crate::fuzzy;
 use crate::low_pass::{LowPass, LOW_PASS_LSB_PER_G};
+use crate::models::{um_to_mm, LengthChain, Model};
+use crate::phase_stats::StrideStats;
+use crate::pipeline::Config;
 use crate::rate::SampleRate;
+use crate::stride::{Stride, StrideFlags};
 
 const fn g_milli(mg: i32) -> i32 {
     // Rounded to the nearest low-pass unit (g/32 768).
@@ -715,5 +723,131 @@ impl PeakValleyDetector {
                 }
             }
         }
+    }
+}
+
+/// Lu's whole chain on one of the peak-valley detector's steps
+/// ([`PeakValleySteps`]), with the paper's constants and no training:
+/// `D` = peak − valley (eq. 11) and the step frequency `f` give the fuzzy `k` over the
+/// paper's universes ([`fuzzy::D_UNIVERSE_Q16`], [`fuzzy::F_UNIVERSE_Q16`]), and Weinberg's
+/// `k·(a_max − a_min)^¼` (eq. 6) is taken with the step's own peak and valley as `a_max`
+/// and `a_min`. Returns the foot's stride, µm.
+///
+/// On a foot the detector sees one peak-valley pair per stride of that foot, so the
+/// walker's step frequency is twice the pairs' (`f = 2·rate/period`), and the foot's
+/// stride is two of the walker's steps: the stride is `2·k·D^¼`. The first step of a walk
+/// has no period; it takes `f` at the bottom of the universe (1 Hz), as a walk starts slowly.
+pub fn lu_chain_um(step: &Step, rate: SampleRate) -> i64 {
+    // D in g, Q16: the low-pass unit is g/32 768 = 2⁻¹⁵ g.
+    let d_q16 = (step.difference().max(0) as i64) << 1;
+    let f_q16 = if step.period == 0 {
+        fuzzy::F_UNIVERSE_Q16.0
+    } else {
+        // 2 · rate(mHz)/1000 / period, Hz, Q16.
+        div_round_i128(
+            2 * rate.millihertz() as i128 * Q16_ONE as i128,
+            1000 * step.period as i128,
+        ) as i64
+    };
+    let k = fuzzy::lu_k_q16(f_q16, fuzzy::F_UNIVERSE_Q16, d_q16, fuzzy::D_UNIVERSE_Q16);
+    let root = root_q16(d_q16 as u64, 4) as i64;
+    // 2 · k · D^¼, Q32 → µm.
+    div_round_i128(2 * k as i128 * root as i128 * 1_000_000, 1i128 << 32) as i64
+}
+
+/// Lu's detector as a step detector ([`crate::detector::StepDetector`]): fed the foot frame's
+/// vertical acceleration, each of its steps becomes a stride record measured by Lu's own
+/// chain ([`lu_chain_um`]) whatever the configured model.
+#[derive(Clone, Debug)]
+pub struct PeakValleySteps {
+    peaks: PeakValleyDetector,
+    rate: SampleRate,
+    /// A step released while filling a hole with no call to report it from.
+    held: Option<Stride>,
+}
+
+impl PeakValleySteps {
+    /// The detector for data described by `config`.
+    pub const fn new(config: &Config) -> Self {
+        PeakValleySteps {
+            peaks: PeakValleyDetector::new(config.rate),
+            rate: config.rate,
+            held: None,
+        }
+    }
+
+    /// One step as a stride record, measured by Lu's chain.
+    #[inline(never)]
+    pub fn measure_step(&self, step: Step) -> Stride {
+        let mut flags = StrideFlags::PHASES_GUESSED;
+        if step.period == 0 {
+            flags |= StrideFlags::FROM_REST;
+        }
+        let mut s = Stride {
+            index: step.index,
+            start: step.peak.index,
+            heel_off: step.peak.index,
+            toe_off: step.peak.index,
+            heel_strike: step.valley.index,
+            foot_flat: step.valley.index,
+            end: step.valley.index,
+            flags: StrideFlags(flags),
+            ..Stride::default()
+        };
+        s.set_length_mm(um_to_mm(lu_chain_um(&step, self.rate)));
+        s
+    }
+}
+
+impl StepDetector for PeakValleySteps {
+    const OWN_MODEL: Option<Model> = Some(Model::LuFuzzy);
+
+    fn delay(&self, filter_delay: u32) -> u32 {
+        filter_delay + self.peaks.filter_delay()
+    }
+
+    fn process(&mut self, x: &Input<'_>, out: &mut Option<Stride>) {
+        if out.is_none() {
+            *out = self.held.take();
+        }
+        // The filtered value is the mean of a window centred `filter_delay` samples back.
+        let at = x.index.wrapping_sub(x.filter_delay);
+        if out.is_none() {
+            *out = self
+                .peaks
+                .process(at, x.foot[2])
+                .map(|s| self.measure_step(s));
+        } else {
+            self.peaks.feed(at, x.foot[2]);
+        }
+    }
+
+    fn restart(&mut self, _: &Drain<'_>) -> Option<Stride> {
+        self.peaks.gap();
+        self.held.take()
+    }
+
+    fn hold(&mut self, stride: Stride) {
+        if self.held.is_none() {
+            self.held = Some(stride);
+        }
+    }
+
+    fn finish(&mut self, _: &Drain<'_>) -> Option<Stride> {
+        if let Some(s) = self.held.take() {
+            return Some(s);
+        }
+        self.peaks.finish().map(|s| self.measure_step(s))
+    }
+
+    fn stats(&self, _: u32) -> Option<&StrideStats> {
+        None
+    }
+
+    /// Measured as it was released, by Lu's chain.
+    fn measure(&self, _: &mut Stride, _: &LengthChain) {}
+
+    fn dropped(&self) -> u32 {
+        self.peaks.dropped()
     }
 }

@@ -351,3 +351,168 @@ fn fuse(refs: &[u32]) -> Option<u32> {
     }
     Some(((kept_sum + kept / 2) / kept) as u32)
 }
+
+#[cfg(test)]
+mod tests {
+    //! The splitter's rules on hand-made movements (g/2048; extremes need 100 mg = 204).
+    use super::*;
+
+    const MERGE: u32 = 10;
+
+    /// A movement of 100 samples, zero but for triangular bumps `(axis, at, height)`, five
+    /// samples wide, their extreme at `at`.
+    fn movement(bumps: &[(usize, usize, i16)]) -> [[i16; 2]; 100] {
+        let mut m = [[0i16; 2]; 100];
+        for &(axis, at, h) in bumps {
+            for (k, w) in [(0usize, 1i16), (1, 2), (2, 3), (3, 2), (4, 1)] {
+                m[at + k - 2][axis] += h / 3 * w;
+            }
+        }
+        m
+    }
+
+    fn extreme(at: u16, value: i16, peak: bool) -> Extreme {
+        Extreme {
+            at,
+            value,
+            axis: VERTICAL,
+            peak,
+        }
+    }
+
+    #[test]
+    fn extremes_are_above_the_noise_floor_and_a_plateau_counts_once() {
+        let mut m = [[0i16; 2]; 20];
+        // A flat top of 1000 over samples 4..=6, a 150 (< 204) bump, a valley at 14.
+        for (i, v) in [
+            (3, 500),
+            (4, 1000),
+            (5, 1000),
+            (6, 1000),
+            (7, 500),
+            (10, 150),
+            (14, -900),
+        ] {
+            m[i][0] = v;
+        }
+        let mut found = Vec::new();
+        find_extremes(&m, &mut found);
+        let got: [(u16, bool); 2] = [(found[0].at, found[0].peak), (found[1].at, found[1].peak)];
+        assert_eq!(found.len(), 2);
+        assert_eq!(got, [(5, true), (14, false)]);
+    }
+
+    #[test]
+    fn a_peak_pairs_with_the_nearest_valley_before_it() {
+        // Valleys at 10 and 30, peak at 25, valley after it at 27 (nearer, but after).
+        let e = [
+            extreme(10, -500, false),
+            extreme(25, 800, true),
+            extreme(27, -900, false),
+            extreme(30, -600, false),
+        ];
+        let p = major_pair(e.iter(), MERGE).unwrap();
+        assert_eq!((p.peak.at, p.valley.at), (25, 10));
+        // No valley before any peak: no pair.
+        assert!(major_pair(
+            [extreme(5, 800, true), extreme(9, -800, false)].iter(),
+            MERGE
+        )
+        .is_none());
+    }
+
+    #[test]
+    fn the_largest_pair_is_major_and_a_close_strong_one_merges_into_it() {
+        // Major: valley 10 (−1000), peak 20 (1000). Second: valley 15 (−700) … peak 18
+        // (900)? No: its nearest valley before 18 is 15. Its peak is within MERGE of the
+        // major valley and its magnitude (1600) over half the major's (2000): merged, the
+        // major keeping its own higher peak and lower valley.
+        let e = [
+            extreme(10, -1000, false),
+            extreme(15, -700, false),
+            extreme(18, 900, true),
+            extreme(30, -200, false),
+            extreme(40, 1100, true),
+        ];
+        // Pairs: (18, 15) magnitude 1600, (40, 30) magnitude 1300: (18, 15) is major.
+        let p = major_pair(e.iter(), MERGE).unwrap();
+        assert_eq!((p.peak.at, p.valley.at), (18, 15));
+        // A pair whose peak is within MERGE of the major valley and more than half as large
+        // lends its higher peak and lower valley.
+        let e = [
+            extreme(10, -1000, false),
+            extreme(14, 1000, true),
+            extreme(16, -1200, false),
+            extreme(20, 1200, true),
+        ];
+        // (14, 10): 2000; (20, 16): 2400 is major; (14, 10)'s peak is 2 from valley 16 and
+        // 2000 > 1200: merged, keeping the higher peak (1200 at 20) and the lower valley
+        // (−1200 at 16).
+        let p = major_pair(e.iter(), MERGE).unwrap();
+        assert_eq!((p.peak.at, p.valley.at), (20, 16));
+        // A weak close pair (under half) does not merge; neither does a far one.
+        let e = [
+            extreme(10, -2000, false),
+            extreme(12, 2000, true),
+            extreme(30, -300, false),
+            extreme(33, 300, true),
+        ];
+        let p = major_pair(e.iter(), MERGE).unwrap();
+        assert_eq!((p.peak.at, p.valley.at, p.peak.value), (12, 10, 2000));
+    }
+
+    #[test]
+    fn fuse_drops_a_reference_far_from_the_others() {
+        assert_eq!(fuse(&[]), None);
+        assert_eq!(
+            fuse(&[10, 13]),
+            Some(12),
+            "two references: their mean, rounded"
+        );
+        assert_eq!(
+            fuse(&[20, 21, 19, 60]),
+            Some(20),
+            "60 is > 3σ from the others"
+        );
+        assert_eq!(fuse(&[20, 24, 28]), Some(24), "nothing is an outlier");
+    }
+
+    #[test]
+    fn short_or_flat_movements_fall_back_to_the_quarter_points() {
+        let flat = [[0i16; 2]; 40];
+        let s = split(&flat, PhaseMethod::Augmented, MERGE);
+        assert_eq!((s.toe_off, s.heel_strike, s.found), (10, 30, false));
+        let s = split(&flat[..2], PhaseMethod::MajorPairs, MERGE);
+        assert!(!s.found && s.toe_off <= s.heel_strike);
+        let s = split::<2>(&[], PhaseMethod::MajorPairs, MERGE);
+        assert_eq!((s.toe_off, s.heel_strike, s.found), (0, 0, false));
+    }
+
+    #[test]
+    fn push_off_and_heel_strike_come_from_the_two_clusters() {
+        // Push-off (left): sagittal valley 10 → peak 20, vertical valley 20 → peak 30.
+        // Heel-strike (right): sagittal valley 70 → peak 80, vertical valley 72 → peak 80.
+        let m = movement(&[
+            (SAGITTAL as usize, 10, -900),
+            (SAGITTAL as usize, 20, 900),
+            (VERTICAL as usize, 20, -900),
+            (VERTICAL as usize, 30, 900),
+            (SAGITTAL as usize, 70, -900),
+            (SAGITTAL as usize, 80, 900),
+            (VERTICAL as usize, 72, -900),
+            (VERTICAL as usize, 80, 900),
+        ]);
+        let s = split(&m, PhaseMethod::MajorPairs, MERGE);
+        // Toe-off: mean of the sagittal peak (20) and the vertical valley (20); heel-strike:
+        // of the two peaks (80, 80).
+        assert_eq!((s.toe_off, s.heel_strike, s.found), (20, 80, true));
+        // The augmented splitter adds the derivatives' zero crossings near each pair; on
+        // these bumps they stay within two samples of the pairs' answer.
+        let a = split(&m, PhaseMethod::Augmented, MERGE);
+        assert!(a.found);
+        assert!(
+            a.toe_off.abs_diff(20) <= 2 && a.heel_strike.abs_diff(80) <= 2,
+            "{a:?}"
+        );
+    }
+}

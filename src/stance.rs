@@ -310,3 +310,103 @@ impl StanceDetector {
         Some(still)
     }
 }
+
+#[cfg(test)]
+mod tests {
+    //! The detector's windows and thresholds on hand-made signals at 200 Hz, ±2000 °/s
+    //! (16.4 counts per °/s: the gyro threshold of 0.7 rad/s is 657 counts).
+    use super::*;
+
+    fn detector() -> StanceDetector {
+        let rate = SampleRate::from_hz(200).unwrap();
+        StanceDetector::new(StanceThresholds::new(rate, GyroRange::Dps2000))
+    }
+
+    /// Decisions about every centre for a signal given per input sample.
+    fn decisions(signal: impl Fn(u32) -> ([i16; 3], [i16; 3]), n: u32) -> [Option<bool>; 512] {
+        let mut d = detector();
+        let mut out = [None; 512];
+        for i in 0..n {
+            let (foot, gyro) = signal(i);
+            if let Some(still) = d.process(foot, gyro) {
+                out[(i - d.delay()) as usize] = Some(still);
+            }
+        }
+        out
+    }
+
+    #[test]
+    fn windows_are_centred_and_the_answer_waits_for_the_largest() {
+        let t = StanceThresholds::new(SampleRate::from_hz(200).unwrap(), GyroRange::Dps2000);
+        assert_eq!(t.half, [3, 6, 12]);
+        assert_eq!(t.delay(), 12);
+        let mut d = detector();
+        // No answer until the largest window (2·12 + 1) is full.
+        for i in 0..24 {
+            assert_eq!(d.process([0; 3], [0; 3]), None, "input {i}");
+        }
+        assert_eq!(d.process([0; 3], [0; 3]), Some(true));
+    }
+
+    #[test]
+    fn the_gyro_threshold_is_0_7_rad_per_s() {
+        let below = decisions(|_| ([0; 3], [650, 0, 0]), 100);
+        let above = decisions(|_| ([0; 3], [0, 670, 0]), 100);
+        assert!(below[12..88].iter().all(|d| *d == Some(true)));
+        assert!(above[12..88].iter().all(|d| *d == Some(false)));
+    }
+
+    #[test]
+    fn a_rotation_spike_clears_the_stance_over_the_gyro_window_only() {
+        let d = decisions(|i| ([0; 3], [if i == 100 { 20_000 } else { 0 }, 0, 0]), 300);
+        for (c, d) in d.iter().enumerate().take(288).skip(12) {
+            // The gyro window is the middle one, ±6 samples (30 ms).
+            assert_eq!(*d, Some(!(94..=106).contains(&c)), "centre {c}");
+        }
+    }
+
+    #[test]
+    fn vibration_under_the_variance_and_iqr_thresholds_is_a_stance() {
+        // ±200 counts (0.1 g) alternating: deflated ±156, well under both thresholds
+        // (1022 deflated units for each); ±800 (0.4 g), deflated ±2500, is not.
+        let shake = |a: i16| move |i: u32| ([0, 0, if i % 2 == 0 { a } else { -a }], [0; 3]);
+        let small = decisions(shake(200), 100);
+        let large = decisions(shake(800), 100);
+        assert!(small[12..88].iter().all(|d| *d == Some(true)));
+        assert!(large[12..88].iter().all(|d| *d == Some(false)));
+        // On the sagittal axis too.
+        let sagittal = decisions(
+            |i| ([if i % 2 == 0 { 800 } else { -800 }, 0, 0], [0; 3]),
+            100,
+        );
+        assert!(sagittal[12..88].iter().all(|d| *d == Some(false)));
+    }
+
+    #[test]
+    fn a_constant_acceleration_has_no_variance() {
+        // A tilted foot at rest: the mean is not what the detector judges.
+        let d = decisions(|_| ([900, -400, 700], [0; 3]), 100);
+        assert!(d[12..88].iter().all(|d| *d == Some(true)));
+    }
+
+    #[test]
+    fn reset_forgets_the_history() {
+        let mut d = detector();
+        for _ in 0..50 {
+            d.process([0; 3], [5000, 0, 0]);
+        }
+        d.reset();
+        for _ in 0..24 {
+            assert_eq!(d.process([0; 3], [0; 3]), None);
+        }
+        assert_eq!(d.process([0; 3], [0; 3]), Some(true));
+    }
+
+    #[test]
+    fn deflate_keeps_the_sign_and_squares_the_magnitude() {
+        assert_eq!(deflate(0), 0);
+        assert_eq!(deflate(2048), 2048 * 8);
+        assert_eq!(deflate(-2048), -2048 * 8);
+        assert_eq!(deflate(i16::MIN), -(1 << 22));
+    }
+}

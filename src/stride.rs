@@ -38,13 +38,16 @@
 
 use heapless::Vec;
 
+use crate::detector::{Drain, Input, StepDetector};
 use crate::fixed::isqrt_u64;
 use crate::foot_frame::FOOT_LSB_PER_G;
 use crate::phase_stats::{StrideStats, CHANNELS};
 use crate::phases::{self, PhaseMethod};
+use crate::pipeline::Config;
 use crate::rate::SampleRate;
 use crate::rest::RestSums;
 use crate::sample::{GyroRange, RawSample};
+use crate::stance::{StanceDetector, StanceThresholds};
 use crate::zupt::ZuptIntegrator;
 
 /// Default capacity of the movement buffer: 1.024 s at 1 kHz, 5 s at 204.8 Hz, 10 s at
@@ -142,6 +145,17 @@ pub struct Stride {
     pub climb_mm: i32,
     /// Qualifiers.
     pub flags: StrideFlags,
+}
+
+impl Stride {
+    /// Sets the length, clamped to [`MAX_STRIDE_MM`] and flagged
+    /// [`StrideFlags::IMPLAUSIBLE`] above it.
+    pub fn set_length_mm(&mut self, mm: u32) {
+        if mm > MAX_STRIDE_MM {
+            self.flags.0 |= StrideFlags::IMPLAUSIBLE;
+        }
+        self.length_mm = mm.min(MAX_STRIDE_MM);
+    }
 }
 
 /// Where a sample fed to the tracker comes from: the sensor, or the pipeline's
@@ -602,4 +616,294 @@ pub(crate) fn magnitude_minus_g(foot: [i16; 3]) -> i16 {
     let m2 = (foot[0] as i64).pow(2) + (foot[1] as i64).pow(2) + up * up;
     let m = isqrt_u64(m2 as u64) as i64 - FOOT_LSB_PER_G as i64;
     m.clamp(i16::MIN as i64, i16::MAX as i64) as i16
+}
+
+/// Huang's method as a step detector ([`crate::detector::StepDetector`]): the variance + IQR
+/// stance detector ([`crate::stance`]) deciding about each sample, and the tracker above
+/// turning its decisions into strides, stance to stance.
+#[derive(Clone, Debug)]
+pub struct StanceStrides<const M: usize = MAX_MOVEMENT_SAMPLES> {
+    stance: StanceDetector,
+    tracker: StrideTracker<M>,
+    /// Decisions made since the last restart (the drain feeds the rest of the delay line
+    /// only after one).
+    decided: u32,
+    last_decision: bool,
+}
+
+impl<const M: usize> StanceStrides<M> {
+    /// The detector and tracker for data described by `config`.
+    pub const fn new(config: &Config) -> Self {
+        StanceStrides {
+            stance: StanceDetector::new(StanceThresholds::with_limits(
+                config.rate,
+                config.gyro,
+                config.stance,
+            )),
+            tracker: StrideTracker::sized(config.rate, config.gyro, config.phases),
+            decided: 0,
+            last_decision: false,
+        }
+    }
+
+    /// Feeds the tracker the samples still in the delay line, with the last stance decision;
+    /// returns the stride they let it report, if any.
+    fn drain(&mut self, x: &Drain<'_>) -> Option<Stride> {
+        let mut closed = None;
+        // The tracker has had samples up to `next − 1 − delay`; the foot-frame values reach
+        // `next − 1 − filter delay`, so that many more can be drained.
+        let fd = x.filter_delay;
+        let pending = if self.decided == 0 {
+            0
+        } else {
+            self.stance.delay()
+        };
+        for k in (0..pending).rev() {
+            let at = x.next.wrapping_sub(1 + fd).wrapping_sub(k);
+            let foot = x.lines.foot(at.wrapping_add(fd));
+            let raw = x.lines.raw(at);
+            let origin = x.lines.origin(at);
+            if let Some(st) = self
+                .tracker
+                .process(at, &raw, foot, self.last_decision, origin)
+            {
+                closed = Some(st);
+            }
+        }
+        // Drained once: a second drain before new samples would feed them again.
+        self.decided = 0;
+        closed
+    }
+}
+
+impl<const M: usize> StepDetector for StanceStrides<M> {
+    fn delay(&self, filter_delay: u32) -> u32 {
+        self.stance.delay() + filter_delay
+    }
+
+    fn process(&mut self, x: &Input<'_>, out: &mut Option<Stride>) {
+        let Some(decision) = self.stance.process(x.foot, x.newest.gyro) else {
+            return;
+        };
+        self.decided = self.decided.saturating_add(1);
+        self.last_decision = decision;
+        let delay = self.delay(x.filter_delay);
+        if x.since_reset <= delay {
+            return;
+        }
+        let at = x.index.wrapping_sub(delay);
+        let foot = x.lines.foot(x.index.wrapping_sub(self.stance.delay()));
+        let raw = x.lines.raw(at);
+        self.tracker
+            .process_into(at, &raw, foot, decision, x.lines.origin(at), out);
+    }
+
+    fn restart(&mut self, x: &Drain<'_>) -> Option<Stride> {
+        // The drain runs on one stance decision, so it makes one transition at most, and
+        // then the tracker holds nothing to hand back; should both ever carry a stride, the
+        // later one stays held (reported after the gap), so nothing is lost.
+        let drained = self.drain(x);
+        self.stance.reset();
+        match (drained, self.tracker.gap()) {
+            (Some(a), Some(b)) => {
+                self.tracker.hold(b);
+                Some(a)
+            }
+            (a, b) => a.or(b),
+        }
+    }
+
+    fn hold(&mut self, stride: Stride) {
+        self.tracker.hold(stride);
+    }
+
+    fn finish(&mut self, x: &Drain<'_>) -> Option<Stride> {
+        self.drain(x).or_else(|| self.tracker.finish())
+    }
+
+    fn stats(&self, index: u32) -> Option<&StrideStats> {
+        self.tracker.stats(index)
+    }
+
+    fn dropped(&self) -> u32 {
+        self.tracker.dropped()
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    //! Every transition of the tracker on hand-made stance decisions: 200 Hz, a foot at
+    //! rest on a level floor (1 g up, no rotation) during stances.
+    use super::*;
+
+    const RATE_HZ: u32 = 200;
+    /// 1 g on the ±16 g range's 2048 counts per g.
+    const REST: RawSample = RawSample {
+        accel: [0, 0, 2048],
+        gyro: [0; 3],
+        temp: 0,
+    };
+
+    fn tracker() -> StrideTracker<MAX_MOVEMENT_SAMPLES> {
+        let rate = SampleRate::from_hz(RATE_HZ).unwrap();
+        StrideTracker::sized(rate, GyroRange::Dps2000, PhaseMethod::Augmented)
+    }
+
+    /// Feeds runs of `(stance, samples)` from sample `*next`; returns each stride with the
+    /// sample whose feeding released it.
+    fn feed(t: &mut StrideTracker, next: &mut u32, runs: &[(bool, u32)]) -> Vec<(u32, Stride), 8> {
+        let mut out = Vec::new();
+        for &(stance, n) in runs {
+            for _ in 0..n {
+                let foot = if stance { [0; 3] } else { [300, 0, 300] };
+                if let Some(s) = t.process(*next, &REST, foot, stance, Origin::Measured) {
+                    out.push((*next, s)).unwrap();
+                }
+                *next += 1;
+            }
+        }
+        out
+    }
+
+    #[test]
+    fn movement_before_the_first_stance_is_ignored() {
+        let (mut t, mut n) = (tracker(), 0);
+        assert!(feed(&mut t, &mut n, &[(false, 100), (true, 50)]).is_empty());
+        assert_eq!(t.finish(), None);
+    }
+
+    #[test]
+    fn a_stride_is_released_at_the_next_heel_off_and_the_last_after_a_long_stance() {
+        let (mut t, mut n) = (tracker(), 0);
+        // Rest 1.5 s, a 300 ms movement, a 200 ms stance, another movement, then rest.
+        let out = feed(
+            &mut t,
+            &mut n,
+            &[
+                (true, 300),
+                (false, 60),
+                (true, 40),
+                (false, 60),
+                (true, 250),
+            ],
+        );
+        assert_eq!(out.len(), 2, "{out:?}");
+        let (at, first) = out[0];
+        assert_eq!(at, 400, "released by the second heel-off");
+        assert_eq!(
+            (first.heel_off, first.foot_flat, first.end),
+            (300, 360, 360)
+        );
+        // From a rest longer than MAX_STANCE_IN_STRIDE_MS: the start is that long before
+        // heel-off.
+        assert_eq!(first.start, 300 - 200);
+        assert!(first.flags.has(StrideFlags::FROM_REST));
+        assert!(!first.flags.has(StrideFlags::TO_REST));
+        assert!(first.heel_off < first.toe_off && first.toe_off < first.heel_strike);
+        assert!(first.heel_strike < first.foot_flat);
+        let (at, second) = out[1];
+        // The stance after it ends the walk once it is longer than 1 s (200 samples).
+        assert_eq!(at, 460 + 201);
+        assert_eq!(
+            (second.start, second.heel_off, second.foot_flat),
+            (360, 400, 460)
+        );
+        assert!(second.flags.has(StrideFlags::TO_REST));
+        assert!(!second.flags.has(StrideFlags::FROM_REST));
+        assert_eq!((first.index, second.index), (0, 1));
+        assert_eq!(t.finish(), None);
+        assert_eq!(t.dropped(), 0);
+    }
+
+    #[test]
+    fn a_movement_shorter_than_the_minimum_is_a_wobble_of_the_stance() {
+        let (mut t, mut n) = (tracker(), 0);
+        // 100 ms of movement (< MIN_MOVEMENT_MS) inside a stance, then a real step.
+        let out = feed(
+            &mut t,
+            &mut n,
+            &[
+                (true, 50),
+                (false, 20),
+                (true, 50),
+                (false, 60),
+                (true, 250),
+            ],
+        );
+        assert_eq!(out.len(), 1, "{out:?}");
+        let s = out[0].1;
+        // The stance kept its start through the wobble.
+        assert_eq!((s.start, s.heel_off, s.foot_flat), (0, 120, 180));
+    }
+
+    #[test]
+    fn the_stride_held_at_the_end_is_finished_towards_rest() {
+        let (mut t, mut n) = (tracker(), 0);
+        let out = feed(&mut t, &mut n, &[(true, 100), (false, 60), (true, 10)]);
+        assert!(out.is_empty());
+        let last = t
+            .finish()
+            .expect("the stride waiting for its stance to end");
+        assert_eq!((last.heel_off, last.foot_flat), (100, 160));
+        assert!(last.flags.has(StrideFlags::TO_REST));
+        assert_eq!(t.finish(), None);
+    }
+
+    #[test]
+    fn a_gap_in_a_movement_makes_a_gap_stride_closed_at_the_next_stance() {
+        let (mut t, mut n) = (tracker(), 0);
+        let before = feed(&mut t, &mut n, &[(true, 100), (false, 30)]);
+        assert!(before.is_empty());
+        assert_eq!(t.gap(), None);
+        n += 10; // the samples lost
+        let out = feed(&mut t, &mut n, &[(false, 20), (true, 250)]);
+        assert_eq!(out.len(), 1, "{out:?}");
+        let s = out[0].1;
+        assert!(s.flags.has(StrideFlags::GAP));
+        assert_eq!((s.heel_off, s.end), (100, 160));
+    }
+
+    #[test]
+    fn a_gap_in_a_stance_makes_a_gap_stride_only_if_the_foot_moved_long_enough() {
+        // Moving less than the minimum after the gap: no stride happened.
+        let (mut t, mut n) = (tracker(), 0);
+        feed(&mut t, &mut n, &[(true, 100)]);
+        assert_eq!(t.gap(), None);
+        assert!(feed(&mut t, &mut n, &[(false, 10), (true, 250)]).is_empty());
+        assert_eq!(t.finish(), None);
+        // Moving longer: a gap stride from the stance before the hole.
+        let (mut t, mut n) = (tracker(), 0);
+        feed(&mut t, &mut n, &[(true, 100)]);
+        t.gap();
+        let out = feed(&mut t, &mut n, &[(false, 60), (true, 250)]);
+        assert_eq!(out.len(), 1, "{out:?}");
+        assert!(out[0].1.flags.has(StrideFlags::GAP));
+    }
+
+    #[test]
+    fn the_stride_complete_before_a_gap_is_handed_back_by_it() {
+        let (mut t, mut n) = (tracker(), 0);
+        feed(&mut t, &mut n, &[(true, 100), (false, 60), (true, 20)]);
+        let held = t.gap().expect("the stride waiting for its stance to end");
+        assert_eq!((held.heel_off, held.foot_flat), (100, 160));
+        assert!(!held.flags.has(StrideFlags::GAP));
+    }
+
+    #[test]
+    fn interpolated_samples_flag_the_stride_they_fall_in() {
+        let (mut t, mut n) = (tracker(), 0);
+        feed(&mut t, &mut n, &[(true, 100), (false, 30)]);
+        t.process(n, &REST, [300, 0, 300], false, Origin::Bridged);
+        n += 1;
+        feed(&mut t, &mut n, &[(false, 29), (true, 10)]);
+        let s = t.finish().unwrap();
+        assert!(s.flags.has(StrideFlags::BRIDGED) && s.flags.valid());
+        let (mut t, mut n) = (tracker(), 0);
+        feed(&mut t, &mut n, &[(true, 100), (false, 30)]);
+        t.process(n, &REST, [300, 0, 300], false, Origin::Filled);
+        n += 1;
+        feed(&mut t, &mut n, &[(false, 29), (true, 10)]);
+        let s = t.finish().unwrap();
+        assert!(s.flags.has(StrideFlags::GAP) && !s.flags.valid());
+    }
 }

@@ -3,14 +3,14 @@
 //!
 //! * [`bench_sample`]: one sample from its 14 register bytes through [`Pipeline::process`].
 //!   Inside it, the per-stride work runs in `CycleDetector::close` (phases, phase statistics,
-//!   the ZUPT displacement with its tilt restored) and `Pipeline::measure` (features and the default model), which
+//!   the ZUPT displacement with its tilt restored) and `LengthChain::measure` (features and the default model), which
 //!   the counting plugin measures apart, so the per-sample figure is the sample path alone.
 //! * [`bench_features`] and [`bench_model`]: the features of each stride and every model this
 //!   build carries, one call each, in [`Model::ALL`] order (printed at the end).
 //!
 //! With the `peak-valley-detector` feature the pipeline runs Lu's detector instead: the
 //! sample path then covers its low-pass and rules, and each step's length (Lu's chain) is
-//! counted in `Pipeline::measure_step`; there are no features or models to call.
+//! counted in `PeakValleySteps::measure_step`; there are no features or models to call.
 //!
 //! No interrupts run: the counts are the pipeline's own. The board is the QEMU machine of the
 //! target (mps2-an386 for thumbv7em, microbit for thumbv6m), with the movement buffer of the
@@ -35,6 +35,7 @@ use gaitclip::pipeline::{Config, Detector, Pipeline};
 use gaitclip::rate::SampleRate;
 use gaitclip::sample::{AccelRange, GyroRange, RawSample, SAMPLE_BYTES};
 use gaitclip::stride::Stride;
+use gaitclip_board::Steps;
 use static_cell::ConstStaticCell;
 
 /// The movement buffer of the firmware on the same board (see `boards/microbit/main.rs`).
@@ -57,14 +58,15 @@ const CONFIG: Config = {
         unwrap(AccelRange::from_afs_sel(trace::ACCEL_AFS_SEL)),
         unwrap(GyroRange::from_fs_sel(trace::GYRO_FS_SEL)),
     );
-    if cfg!(feature = "peak-valley-detector") {
-        c.detector = Detector::PeakValley;
-    }
+    c.detector = gaitclip_board::DETECTOR;
     c
 };
 
-static PIPELINE: ConstStaticCell<Pipeline<MOVEMENT_SAMPLES>> =
-    ConstStaticCell::new(Pipeline::sized(CONFIG));
+/// The pipeline with the firmware's detector (the cycle detector, or Lu's with the
+/// `peak-valley-detector` feature), as the board ships it.
+type BenchPipeline = Pipeline<Steps<MOVEMENT_SAMPLES>>;
+static PIPELINE: ConstStaticCell<BenchPipeline> =
+    ConstStaticCell::new(Pipeline::with_detector(CONFIG, Steps::new(&CONFIG)));
 
 /// What the benchmark found: strides and their summed length.
 #[derive(Default)]
@@ -109,7 +111,7 @@ fn main() -> ! {
 // Not inlined, nor is `drain`: their strides and features (≈ 1.3 KiB) would otherwise sit in
 // `main`'s frame under the whole sample path, and the M0's stack is ≈ 8 KiB.
 #[inline(never)]
-fn on_stride(totals: &mut Totals, pipeline: &Pipeline<MOVEMENT_SAMPLES>, s: &Stride) {
+fn on_stride(totals: &mut Totals, pipeline: &BenchPipeline, s: &Stride) {
     totals.strides += 1;
     totals.distance_mm += u64::from(s.length_mm);
     if CONFIG.detector == Detector::PeakValley {
@@ -130,11 +132,8 @@ fn on_stride(totals: &mut Totals, pipeline: &Pipeline<MOVEMENT_SAMPLES>, s: &Str
 
 /// The strides still held at the end of the trace.
 #[inline(never)]
-fn drain(pipeline: &mut Pipeline<MOVEMENT_SAMPLES>, totals: &mut Totals) {
-    for s in pipeline.finish().iter().flatten() {
-        on_stride(totals, pipeline, s);
-    }
-    while let Some(s) = pipeline.take() {
+fn drain(pipeline: &mut BenchPipeline, totals: &mut Totals) {
+    while let Some(s) = pipeline.finish() {
         on_stride(totals, pipeline, &s);
     }
 }
@@ -156,10 +155,7 @@ const fn registers(motion: &[u8; trace::MOTION_BYTES]) -> [u8; SAMPLE_BYTES] {
 
 /// One sample through the per-sample path: decoding its registers and the pipeline.
 #[inline(never)]
-fn bench_sample(
-    pipeline: &mut Pipeline<MOVEMENT_SAMPLES>,
-    regs: &[u8; SAMPLE_BYTES],
-) -> Option<Stride> {
+fn bench_sample(pipeline: &mut BenchPipeline, regs: &[u8; SAMPLE_BYTES]) -> Option<Stride> {
     let s = RawSample::from_be_bytes(regs);
     // black_box keeps the call a `bl` with a return (no tail call) for the counter to see.
     black_box(pipeline.process(&s))

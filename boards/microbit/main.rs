@@ -10,7 +10,7 @@
 
 mod nrf51_timer;
 
-use gaitclip_board::replay_app;
+use gaitclip_board::{replay_app, Steps};
 
 use cortex_m::peripheral::NVIC;
 use cortex_m_rt::{entry, exception};
@@ -45,8 +45,9 @@ impl SampleTimer for Nrf51Timer {
 /// The pipeline, built at compile time into .data: no copy of it ever sits on the stack
 /// (moving 8–12 KiB through the stack is more than a 16 KiB part can spare), and the stack
 /// holds only what one sample's processing needs.
-static PIPELINE: ConstStaticCell<Pipeline<MOVEMENT_SAMPLES>> =
-    ConstStaticCell::new(Pipeline::sized(replay_app::CONFIG));
+static PIPELINE: ConstStaticCell<Pipeline<Steps<MOVEMENT_SAMPLES>>> = ConstStaticCell::new(
+    Pipeline::with_detector(replay_app::CONFIG, Steps::new(&replay_app::CONFIG)),
+);
 
 #[entry]
 fn main() -> ! {

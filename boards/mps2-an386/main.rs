@@ -10,7 +10,7 @@
 
 mod cmsdk_timer;
 
-use gaitclip_board::replay_app;
+use gaitclip_board::{replay_app, Steps};
 
 use cortex_m::peripheral::NVIC;
 use cortex_m_rt::{entry, exception};
@@ -40,8 +40,9 @@ impl SampleTimer for CmsdkTimer {
 /// The pipeline, built at compile time into .data: no copy of it ever sits on the stack
 /// (moving 8–12 KiB through the stack is more than a 16 KiB part can spare), and the stack
 /// holds only what one sample's processing needs.
-static PIPELINE: ConstStaticCell<Pipeline<MAX_MOVEMENT_SAMPLES>> =
-    ConstStaticCell::new(Pipeline::sized(replay_app::CONFIG));
+static PIPELINE: ConstStaticCell<Pipeline<Steps<MAX_MOVEMENT_SAMPLES>>> = ConstStaticCell::new(
+    Pipeline::with_detector(replay_app::CONFIG, Steps::new(&replay_app::CONFIG)),
+);
 
 #[entry]
 fn main() -> ! {

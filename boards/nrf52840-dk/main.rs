@@ -17,7 +17,7 @@
 #![no_std]
 #![no_main]
 
-use gaitclip_board::{imu_sampler, live_app, startup, stride_log};
+use gaitclip_board::{imu_sampler, live_app, startup, stride_log, Steps};
 
 use core::cell::RefCell;
 
@@ -27,7 +27,7 @@ use defmt_rtt as _;
 use embedded_hal::delay::DelayNs;
 use embedded_hal::i2c::{ErrorType, I2c, Operation, SevenBitAddress};
 use gaitclip::mpu6050::{self, Address, Mpu6050, OutputRate};
-use gaitclip::pipeline::Pipeline;
+use gaitclip::pipeline::{Config, Pipeline};
 use gaitclip::rate::SampleRate;
 use gaitclip::sample::{AccelRange, GyroRange};
 use gaitclip::stride::MAX_MOVEMENT_SAMPLES;
@@ -137,8 +137,10 @@ static GPIOTE: Mutex<RefCell<Option<Gpiote>>> = Mutex::new(RefCell::new(None));
 type WatchdogTimer = Timer<TIMER1, Periodic>;
 static WATCHDOG: Mutex<RefCell<Option<(WatchdogTimer, Watchdog)>>> = Mutex::new(RefCell::new(None));
 static QUEUE: ConstStaticCell<Queue<Item, QUEUE_LEN>> = ConstStaticCell::new(Queue::new());
-static PIPELINE: ConstStaticCell<Pipeline<MAX_MOVEMENT_SAMPLES>> =
-    ConstStaticCell::new(Pipeline::sized(live_app::config(RATE, ACCEL, GYRO)));
+/// The pipeline's configuration.
+const CONFIG: Config = live_app::config(RATE, ACCEL, GYRO);
+static PIPELINE: ConstStaticCell<Pipeline<Steps<MAX_MOVEMENT_SAMPLES>>> =
+    ConstStaticCell::new(Pipeline::with_detector(CONFIG, Steps::new(&CONFIG)));
 
 #[entry]
 fn main() -> ! {

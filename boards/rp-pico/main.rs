@@ -15,7 +15,7 @@
 #![no_std]
 #![no_main]
 
-use gaitclip_board::{imu_sampler, live_app, startup, stride_log};
+use gaitclip_board::{imu_sampler, live_app, startup, stride_log, Steps};
 
 use core::cell::RefCell;
 
@@ -26,7 +26,7 @@ use embedded_hal::digital::OutputPin;
 use embedded_hal::i2c::{ErrorType, I2c, Operation, SevenBitAddress};
 use fugit::{HertzU32, RateExtU32};
 use gaitclip::mpu6050::{self, Address, Mpu6050, OutputRate};
-use gaitclip::pipeline::Pipeline;
+use gaitclip::pipeline::{Config, Pipeline};
 use gaitclip::rate::SampleRate;
 use gaitclip::sample::{AccelRange, GyroRange};
 use gaitclip::stride::MAX_MOVEMENT_SAMPLES;
@@ -152,8 +152,10 @@ static LINK: SampleLink<RecoverableI2c, SpinDelay> = SampleLink::new();
 static INT_PIN: Mutex<RefCell<Option<IntPin>>> = Mutex::new(RefCell::new(None));
 static WATCHDOG: Mutex<RefCell<Option<(Alarm0, SensorWatchdog)>>> = Mutex::new(RefCell::new(None));
 static QUEUE: ConstStaticCell<Queue<Item, QUEUE_LEN>> = ConstStaticCell::new(Queue::new());
-static PIPELINE: ConstStaticCell<Pipeline<MAX_MOVEMENT_SAMPLES>> =
-    ConstStaticCell::new(Pipeline::sized(live_app::config(RATE, ACCEL, GYRO)));
+/// The pipeline's configuration.
+const CONFIG: Config = live_app::config(RATE, ACCEL, GYRO);
+static PIPELINE: ConstStaticCell<Pipeline<Steps<MAX_MOVEMENT_SAMPLES>>> =
+    ConstStaticCell::new(Pipeline::with_detector(CONFIG, Steps::new(&CONFIG)));
 
 #[hal::entry]
 fn main() -> ! {

@@ -28,7 +28,7 @@ pub const MEASURED: [(&str, &str); 7] = [
     ("features", "bench::bench_features"),
     ("model", "bench::bench_model"),
     ("close", "gaitclip::cycle::CycleDetector<_>::close"),
-    ("measure", "gaitclip::pipeline::Pipeline<_>::measure"),
+    ("measure", "gaitclip::models::LengthChain::measure"),
     ("split", "gaitclip::phases::split"),
     ("stats", "gaitclip::phase_stats::StrideStats::measure"),
 ];
@@ -37,7 +37,10 @@ pub const MEASURED: [(&str, &str); 7] = [
 /// detector): the sample path, and Lu's chain on each step, out of line in every build.
 pub const MEASURED_PEAK_VALLEY: [(&str, &str); 2] = [
     ("sample", "bench::bench_sample"),
-    ("step", "gaitclip::pipeline::Pipeline<_>::measure_step"),
+    (
+        "step",
+        "gaitclip::peak_valley::PeakValleySteps::measure_step",
+    ),
 ];
 
 /// Instructions of each call of one function, in the order the calls returned.
@@ -143,7 +146,7 @@ pub struct InsnReport {
     pub split: Stat,
     /// `StrideStats::measure` (inside close).
     pub stats: Stat,
-    /// `Pipeline::measure`: features and the default model.
+    /// `LengthChain::measure`: features and the default model.
     pub measure: Stat,
     /// close + measure of each stride: the pipeline's per-stride work.
     pub stride: Stat,
@@ -167,11 +170,11 @@ pub struct StepInsnReport {
     /// Their summed length, mm.
     pub distance_mm: u64,
     /// The sample path: `Pipeline::process` with the low-pass and Lu's rules, without
-    /// `Pipeline::measure_step`.
+    /// `PeakValleySteps::measure_step`.
     pub sample: Stat,
     /// Everything per sample, the steps' chain spread over the samples (mean only).
     pub sample_all_mean: f64,
-    /// `Pipeline::measure_step`: Lu's chain (D, f, fuzzy K, Weinberg) on one step.
+    /// `PeakValleySteps::measure_step`: Lu's chain (D, f, fuzzy K, Weinberg) on one step.
     pub step: Stat,
 }
 
@@ -725,7 +728,7 @@ fn render(r: &Report) -> String {
     );
     let _ = writeln!(
         o,
-        "| · features and default model (`Pipeline::measure`) | {} | {} |",
+        "| · features and default model (`LengthChain::measure`) | {} | {} |",
         f(&m4.measure),
         f(&m0.measure)
     );
@@ -768,7 +771,7 @@ fn render(r: &Report) -> String {
     );
     let _ = writeln!(
         o,
-        "| per step: Lu's chain (`Pipeline::measure_step`) | {} | {} |",
+        "| per step: Lu's chain (`PeakValleySteps::measure_step`) | {} | {} |",
         f(&l4.step),
         f(&l0.step)
     );

@@ -57,7 +57,7 @@ pub fn run(counts: &[RawSample], gaps: &[Gap], config: Config) -> CoreRun {
             calibration[at] = p.cycle_calibration();
         }
     }
-    strides.extend(p.finish().into_iter().flatten());
+    strides.extend(std::iter::from_fn(|| p.finish()));
     CoreRun {
         strides,
         samples,

@@ -103,10 +103,7 @@ pub fn core_pipeline(data: &[u8]) {
         };
         strides.extend(p.process(&s));
     }
-    strides.extend(p.finish().into_iter().flatten());
-    while let Some(s) = p.take() {
-        strides.push(s);
-    }
+    strides.extend(std::iter::from_fn(|| p.finish()));
     for (k, s) in strides.iter().enumerate() {
         assert!(s.start <= s.heel_off && s.heel_off <= s.toe_off, "{s:?}");
         assert!(

@@ -265,10 +265,7 @@ pub fn core_run_with_stats(
             strides.push(with_stats(&p, st));
         }
     }
-    for st in p.finish().into_iter().flatten() {
-        strides.push(with_stats(&p, st));
-    }
-    while let Some(st) = p.take() {
+    while let Some(st) = p.finish() {
         strides.push(with_stats(&p, st));
     }
     (strides, p.holes())

@@ -84,7 +84,9 @@ fn qemu_m0_bridges_holes_as_the_host_replay() {
     // With the micro:bit's movement buffer (256 samples): the stride the restart breaks
     // runs into the stand after it, longer than that buffer holds (flagged too long there).
     let host_strides = {
-        let mut p = gaitclip::pipeline::Pipeline::<MICROBIT_MOVEMENT_SAMPLES>::sized(config);
+        let mut p = gaitclip::pipeline::Pipeline::<
+            gaitclip::detector::AnyDetector<MICROBIT_MOVEMENT_SAMPLES>,
+        >::sized(config);
         let mut out = Vec::new();
         let mut next_gap = gaps.iter().peekable();
         for (i, s) in counts.iter().enumerate() {
@@ -93,10 +95,7 @@ fn qemu_m0_bridges_holes_as_the_host_replay() {
             }
             out.extend(p.process(s));
         }
-        out.extend(p.finish().into_iter().flatten());
-        while let Some(s) = p.take() {
-            out.push(s);
-        }
+        out.extend(std::iter::from_fn(|| p.finish()));
         out
     };
     let host: Vec<LoggedStride> = host_strides.iter().map(logged).collect();

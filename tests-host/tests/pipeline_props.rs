@@ -1,6 +1,7 @@
 //! Property tests of the core on arbitrary input: never a panic (overflow checks are on in
 //! tests), state bounded by its constants, and every stride well formed.
 
+use gaitclip::detector::AnyDetector;
 use gaitclip::pipeline::{Config, Pipeline, BRIDGE_MAX_MS, FILL_MAX_MS};
 use gaitclip::rate::SampleRate;
 use gaitclip::sample::{AccelRange, GyroRange, RawSample};
@@ -51,7 +52,8 @@ fn check<const M: usize>(
     gaps: &[(usize, u32)],
 ) -> Vec<Stride> {
     let rate = SampleRate::from_hz(rate_hz).unwrap();
-    let mut p = Pipeline::<M>::sized(Config::new(rate, AccelRange::G16, GyroRange::Dps2000));
+    let mut p =
+        Pipeline::<AnyDetector<M>>::sized(Config::new(rate, AccelRange::G16, GyroRange::Dps2000));
     let mut strides = Vec::new();
     for (i, s) in samples.iter().enumerate() {
         for &(_, missing) in gaps.iter().filter(|g| g.0 == i) {
@@ -59,7 +61,7 @@ fn check<const M: usize>(
         }
         strides.extend(p.process(s));
     }
-    strides.extend(p.finish().into_iter().flatten());
+    strides.extend(std::iter::from_fn(|| p.finish()));
     let buffer_ms = M as u64 * 1000 / rate_hz as u64;
     for (k, s) in strides.iter().enumerate() {
         assert!(s.start <= s.heel_off && s.heel_off <= s.toe_off, "{s:?}");

@@ -20,6 +20,7 @@
 
 use embedded_hal::delay::DelayNs;
 use embedded_hal::i2c::I2c;
+use gaitclip::detector::StepDetector;
 use gaitclip::mpu6050::{self, Mpu6050};
 use gaitclip::pipeline::Pipeline;
 use gaitclip::sample::RawSample;
@@ -46,7 +47,7 @@ pub enum Item {
 impl Item {
     /// Hands the item to the pipeline; the stride it lets the pipeline report, if any (a
     /// gap's was closed before the gap).
-    pub fn feed<const M: usize>(self, pipeline: &mut Pipeline<M>) -> Option<Stride> {
+    pub fn feed<D: StepDetector>(self, pipeline: &mut Pipeline<D>) -> Option<Stride> {
         match self {
             Item::Sample(s) => pipeline.process(&s),
             Item::Gap(n) => pipeline.gap(n),

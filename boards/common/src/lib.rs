@@ -21,6 +21,25 @@
 #![no_std]
 #![deny(missing_docs)]
 
+use gaitclip::pipeline::Detector;
+
+/// The firmware's step detector: one stance instant per gait cycle (the every-pace
+/// detector, [`gaitclip::cycle`]), unless the board is built with the `peak-valley-detector`
+/// feature (Lu's detection and chain, [`gaitclip::peak_valley`]). A board's pipeline is a
+/// `Pipeline<Steps<M>>` made with `Steps::new`, `M` its movement buffer: it links only this
+/// detector.
+#[cfg(not(feature = "peak-valley-detector"))]
+pub type Steps<const M: usize> = gaitclip::cycle::CycleDetector<M>;
+/// The firmware's step detector (see the other configuration's documentation).
+#[cfg(feature = "peak-valley-detector")]
+pub type Steps<const M: usize> = gaitclip::peak_valley::PeakValleySteps;
+/// The name of [`Steps`], for the configuration and the logs.
+pub const DETECTOR: Detector = if cfg!(feature = "peak-valley-detector") {
+    Detector::PeakValley
+} else {
+    Detector::Cycle
+};
+
 pub mod imu_sampler;
 pub mod replay_holes;
 pub mod replay_mpu6050;

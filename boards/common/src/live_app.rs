@@ -13,8 +13,9 @@ use core::sync::atomic::{AtomicU32, Ordering};
 use cortex_m::interrupt::{self as irq, Mutex};
 use embedded_hal::delay::DelayNs;
 use embedded_hal::i2c::I2c;
+use gaitclip::detector::StepDetector;
 use gaitclip::mpu6050::{self, Mpu6050};
-use gaitclip::pipeline::{Config, Detector, Pipeline};
+use gaitclip::pipeline::{Config, Pipeline};
 use gaitclip::rate::SampleRate;
 use gaitclip::sample::{AccelRange, GyroRange};
 use heapless::spsc::{Consumer, Producer};
@@ -27,20 +28,11 @@ use crate::stride_log::StrideLog;
 /// Interval of the status line.
 pub const STATUS_EVERY_MS: u32 = 60_000;
 
-/// The firmware's step detector: one stance instant per gait cycle (the every-pace
-/// detector, `gaitclip::cycle`), unless the board is built with the `peak-valley-detector`
-/// feature (Lu's detection and chain; see `gaitclip::pipeline`).
-pub const DETECTOR: Detector = if cfg!(feature = "peak-valley-detector") {
-    Detector::PeakValley
-} else {
-    Detector::Cycle
-};
-
 /// The pipeline's configuration for samples at `rate` in the given ranges, with the
-/// firmware's [`DETECTOR`].
+/// firmware's [`crate::DETECTOR`].
 pub const fn config(rate: SampleRate, accel: AccelRange, gyro: GyroRange) -> Config {
     let mut c = Config::new(rate, accel, gyro);
-    c.detector = DETECTOR;
+    c.detector = crate::DETECTOR;
     c
 }
 /// Period of the board's watchdog timer.
@@ -206,8 +198,8 @@ impl Default for Watchdog {
 
 /// Processes the queue forever. `counters` reads the sampler's fault counters (inside a
 /// critical section, as the interrupt owns the sampler).
-pub fn main_loop<const M: usize>(
-    pipeline: &mut Pipeline<M>,
+pub fn main_loop<D: StepDetector>(
+    pipeline: &mut Pipeline<D>,
     consumer: &mut Consumer<'static, Item>,
     log: &mut StrideLog,
     serial: &mut impl Write,

@@ -13,6 +13,7 @@ use core::sync::atomic::{AtomicBool, Ordering};
 use cortex_m::interrupt as irq;
 use cortex_m_semihosting::debug::{self, EXIT_FAILURE, EXIT_SUCCESS};
 use embedded_hal::delay::DelayNs;
+use gaitclip::detector::StepDetector;
 use gaitclip::mpu6050::{self, Address, Mpu6050};
 use gaitclip::pipeline::{Config, Pipeline};
 use gaitclip::rate::SampleRate;
@@ -102,8 +103,8 @@ unsafe impl cortex_m::interrupt::InterruptNumber for Irq {
 
 /// Runs the trace through `pipeline` (made from [`CONFIG`]; the board keeps it in a static,
 /// sized for its RAM) and exits QEMU. `unmask` enables the timer's interrupt in the NVIC.
-pub fn run<const M: usize>(
-    pipeline: &mut Pipeline<M>,
+pub fn run<D: StepDetector>(
+    pipeline: &mut Pipeline<D>,
     board: &str,
     cycles_per_us: u32,
     timer: &impl SampleTimer,
@@ -167,9 +168,9 @@ pub fn run<const M: usize>(
 /// then live on the stack only while it runs, not for the life of `run`'s frame, which a
 /// 16 KiB part cannot spare.
 #[inline(never)]
-fn handle<const M: usize>(
+fn handle<D: StepDetector>(
     item: Item,
-    pipeline: &mut Pipeline<M>,
+    pipeline: &mut Pipeline<D>,
     startup: &mut Startup,
     log: &mut StrideLog,
     samples: &mut u32,
@@ -196,12 +197,9 @@ fn handle<const M: usize>(
 
 /// The end of the trace: the strides still held, the summary, and QEMU's exit.
 #[inline(never)]
-fn finish<const M: usize>(pipeline: &mut Pipeline<M>, log: &mut StrideLog, samples: u32) -> ! {
+fn finish<D: StepDetector>(pipeline: &mut Pipeline<D>, log: &mut StrideLog, samples: u32) -> ! {
     let serial = &mut NoSerial;
-    for stride in pipeline.finish().iter().flatten() {
-        log.stride(stride, serial);
-    }
-    while let Some(stride) = pipeline.take() {
+    while let Some(stride) = pipeline.finish() {
         log.stride(&stride, serial);
     }
     log.summary(samples, &LINK.counters(), serial);

@@ -13,6 +13,7 @@
 //!
 //! The core keeps refining all of it at every rest; this only reports progress.
 
+use gaitclip::detector::StepDetector;
 use gaitclip::pipeline::Pipeline;
 use gaitclip::rate::SampleRate;
 use gaitclip::sample::GyroRange;
@@ -77,7 +78,7 @@ impl Startup {
     }
 
     /// Call after each sample the pipeline took; returns what to report, if anything.
-    pub fn update<const M: usize>(&mut self, pipeline: &Pipeline<M>) -> Option<StartupEvent> {
+    pub fn update<D: StepDetector>(&mut self, pipeline: &Pipeline<D>) -> Option<StartupEvent> {
         // Called for every sample: once calibrated, nothing more to look at.
         if self.stage == Stage::Done {
             return None;

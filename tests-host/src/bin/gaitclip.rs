@@ -164,7 +164,7 @@ fn stance_limits(v: &str) -> Result<gaitclip::stance::StanceLimits, String> {
 }
 
 fn detector_names() -> clap::builder::PossibleValuesParser {
-    clap::builder::PossibleValuesParser::new(Detector::ALL.map(|d| d.name()))
+    clap::builder::PossibleValuesParser::new(Detector::ALL.iter().map(|d| d.name()))
 }
 
 fn model_names() -> clap::builder::PossibleValuesParser {
