@@ -25,12 +25,14 @@ use crate::pipeline::{Config, DELAY_CAPACITY};
 use crate::sample::RawSample;
 use crate::stride::{Origin, Stride};
 
-/// The delay lines: the last [`DELAY_CAPACITY`] raw samples, their mean-filtered foot-frame
+/// The delay lines: the last [`DELAY_CAPACITY`] raw samples' accelerations and angular
+/// rates (no temperature: no stage after the delay reads it), their mean-filtered foot-frame
 /// values and where each came from, by sample number. The detectors' centred windows decide
 /// about a sample well after it was fed; these give them back what it was.
 #[derive(Clone, Debug)]
 pub struct DelayLines {
-    raw: [RawSample; DELAY_CAPACITY],
+    accel: [[i16; 3]; DELAY_CAPACITY],
+    gyro: [[i16; 3]; DELAY_CAPACITY],
     foot: [[i16; 3]; DELAY_CAPACITY],
     /// One bit per slot: the sample was interpolated ([`Origin::Bridged`]).
     bridged: u128,
@@ -44,11 +46,8 @@ impl DelayLines {
     /// Empty lines.
     pub const fn new() -> Self {
         DelayLines {
-            raw: [RawSample {
-                accel: [0; 3],
-                gyro: [0; 3],
-                temp: 0,
-            }; DELAY_CAPACITY],
+            accel: [[0; 3]; DELAY_CAPACITY],
+            gyro: [[0; 3]; DELAY_CAPACITY],
             foot: [[0; 3]; DELAY_CAPACITY],
             bridged: 0,
             filled: 0,
@@ -57,7 +56,8 @@ impl DelayLines {
 
     /// Stores sample number `index` and where it came from.
     pub fn push(&mut self, index: u32, s: &RawSample, origin: Origin) {
-        self.raw[slot(index)] = *s;
+        self.accel[slot(index)] = s.accel;
+        self.gyro[slot(index)] = s.gyro;
         let bit = 1u128 << slot(index);
         self.bridged &= !bit;
         self.filled &= !bit;
@@ -73,9 +73,13 @@ impl DelayLines {
         self.foot[slot(index)] = foot;
     }
 
-    /// Raw sample number `at` (if it is still in the line).
+    /// Raw sample number `at` (if it is still in the line), its temperature 0.
     pub const fn raw(&self, at: u32) -> RawSample {
-        self.raw[slot(at)]
+        RawSample {
+            accel: self.accel[slot(at)],
+            gyro: self.gyro[slot(at)],
+            temp: 0,
+        }
     }
 
     /// The foot-frame value computed when sample `at` was fed.

@@ -22,7 +22,7 @@
 //! 1.53e−5). `tests-host/tests/lengths.rs` checks every feature against f64 within 1 LSB.
 //! Empty segments give zeros. Work is per stride, not per sample.
 
-use crate::fixed::{div_round_i128, iroot_u128, root_q16};
+use crate::fixed::{div_round_i128, iroot_u128, root_q16, Q16_ONE};
 use crate::foot_frame::FOOT_LSB_PER_G;
 use crate::phase_stats::{Channel, ChannelStats, Segment, StrideStats, CHANNELS, SEGMENTS};
 use crate::rate::SampleRate;
@@ -132,8 +132,6 @@ pub const fn name_parts(i: usize) -> (&'static str, &'static str, &'static str) 
     }
 }
 
-/// 1.0 in Q16.
-pub const Q16_ONE: i64 = 1 << 16;
 /// Shift from foot-frame counts (g/2048) to Q16 g.
 const COUNTS_TO_Q16_SHIFT: u32 = 16 - FOOT_LSB_PER_G.trailing_zeros();
 const _: () = assert!((FOOT_LSB_PER_G as u32).is_power_of_two() && FOOT_LSB_PER_G <= 1 << 16);

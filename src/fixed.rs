@@ -6,6 +6,8 @@
 
 /// 1.0 in Q30.
 pub const Q30_ONE: i32 = 1 << 30;
+/// 1.0 in Q16 (features, model coefficients, fuzzy memberships).
+pub const Q16_ONE: i64 = 1 << 16;
 
 /// Rounded `(a · b) >> 30` of two Q30 values.
 ///

@@ -16,7 +16,7 @@
 //! most 0.002 in `k` (asserted by the host test against an f64 reference with 10⁴ samples
 //! per level; measured 0.0015).
 
-use crate::features::Q16_ONE;
+use crate::fixed::Q16_ONE;
 
 /// Lower end of the output universe, Q16 (0.55).
 pub const K_MIN_Q16: i64 = 36_045;

@@ -31,8 +31,8 @@
 //! writes them with the SVRs into [`crate::trained`]. Step models predict a step; fitted on
 //! strides, their constant simply doubles.
 
-use crate::features::{self, Features, Q16_ONE};
-use crate::fixed::{div_round_i128, root_q16, tenth_root_q16};
+use crate::features::{self, Features};
+use crate::fixed::{div_round_i128, root_q16, tenth_root_q16, Q16_ONE};
 use crate::fuzzy;
 use crate::phase_stats::{Channel, Segment, StrideStats};
 use crate::stride::{Stride, StrideFlags};

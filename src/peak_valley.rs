@@ -60,8 +60,7 @@
 use heapless::Vec;
 
 use crate::detector::{Drain, Input, StepDetector};
-use crate::features::Q16_ONE;
-use crate::fixed::{div_round_i128, root_q16};
+use crate::fixed::{div_round_i128, root_q16, Q16_ONE};
 use crate::fuzzy;
 use crate::low_pass::{LowPass, LOW_PASS_LSB_PER_G};
 use crate::models::{um_to_mm, LengthChain, Model};

@@ -629,6 +629,10 @@ pub struct StanceStrides<const M: usize = MAX_MOVEMENT_SAMPLES> {
     /// only after one).
     decided: u32,
     last_decision: bool,
+    /// A stride released while filling a hole with no call to report it from (the tracker
+    /// may hold the next one already).
+    held: Option<Stride>,
+    dropped: u32,
 }
 
 impl<const M: usize> StanceStrides<M> {
@@ -643,6 +647,8 @@ impl<const M: usize> StanceStrides<M> {
             tracker: StrideTracker::sized(config.rate, config.gyro, config.phases),
             decided: 0,
             last_decision: false,
+            held: None,
+            dropped: 0,
         }
     }
 
@@ -682,6 +688,9 @@ impl<const M: usize> StepDetector for StanceStrides<M> {
     }
 
     fn process(&mut self, x: &Input<'_>, out: &mut Option<Stride>) {
+        if out.is_none() {
+            *out = self.held.take();
+        }
         let Some(decision) = self.stance.process(x.foot, x.newest.gyro) else {
             return;
         };
@@ -704,21 +713,32 @@ impl<const M: usize> StepDetector for StanceStrides<M> {
         // later one stays held (reported after the gap), so nothing is lost.
         let drained = self.drain(x);
         self.stance.reset();
-        match (drained, self.tracker.gap()) {
-            (Some(a), Some(b)) => {
-                self.tracker.hold(b);
-                Some(a)
-            }
-            (a, b) => a.or(b),
+        // In the order they closed; the first is handed back, the second waits in the
+        // tracker (which `gap` emptied), a third here.
+        let mut closed = [self.held.take(), drained, self.tracker.gap()].into_iter().flatten();
+        let first = closed.next();
+        if let Some(second) = closed.next() {
+            self.tracker.hold(second);
         }
+        if let Some(third) = closed.next() {
+            self.held = Some(third);
+        }
+        first
     }
 
     fn hold(&mut self, stride: Stride) {
-        self.tracker.hold(stride);
+        if self.held.is_none() {
+            self.held = Some(stride);
+        } else {
+            self.dropped = self.dropped.saturating_add(1);
+        }
     }
 
     fn finish(&mut self, x: &Drain<'_>) -> Option<Stride> {
-        self.drain(x).or_else(|| self.tracker.finish())
+        self.held
+            .take()
+            .or_else(|| self.drain(x))
+            .or_else(|| self.tracker.finish())
     }
 
     fn stats(&self, index: u32) -> Option<&StrideStats> {
@@ -726,7 +746,7 @@ impl<const M: usize> StepDetector for StanceStrides<M> {
     }
 
     fn dropped(&self) -> u32 {
-        self.tracker.dropped()
+        self.tracker.dropped().saturating_add(self.dropped)
     }
 }
 

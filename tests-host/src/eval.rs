@@ -550,16 +550,7 @@ fn mean(v: &[f64]) -> f64 {
     ratio(v.iter().sum(), v.len() as f64)
 }
 
-/// `q`-quantile of the absolute values (nearest rank), NaN when empty.
-pub fn abs_quantile(v: &[f64], q: f64) -> f64 {
-    let mut a: Vec<f64> = v.iter().map(|x| x.abs()).collect();
-    if a.is_empty() {
-        return f64::NAN;
-    }
-    a.sort_by(f64::total_cmp);
-    let k = ((q * a.len() as f64).ceil() as usize).clamp(1, a.len()) - 1;
-    a[k]
-}
+pub use crate::stats::abs_quantile;
 
 fn overlap(a: (u32, u32), b: (u32, u32)) -> u32 {
     a.1.min(b.1).saturating_sub(a.0.max(b.0))
@@ -942,15 +933,7 @@ fn fmt3(v: f64) -> String {
     }
 }
 
-/// Median of signed values, NaN when empty.
-pub fn median(v: &[f64]) -> f64 {
-    let mut a = v.to_vec();
-    if a.is_empty() {
-        return f64::NAN;
-    }
-    a.sort_by(f64::total_cmp);
-    a[a.len() / 2]
-}
+pub use crate::stats::median;
 
 fn fmt_ms(v: &[f64]) -> String {
     if v.is_empty() {

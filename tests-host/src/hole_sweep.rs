@@ -24,6 +24,7 @@
 //! hole up to it keeps the mean |length difference| of every pattern and place within
 //! [`MEAN_LENGTH_BOUND_M`].
 
+use crate::stats::quantile;
 use std::fmt::Write as _;
 use std::path::Path;
 
@@ -339,15 +340,6 @@ pub fn limit_ms(sweeps: &[(f64, Vec<(Pattern, Cost)>)]) -> f64 {
         limit = limit.min(ok_up_to);
     }
     limit
-}
-
-fn quantile(v: &[f64], q: f64) -> f64 {
-    let mut a = v.to_vec();
-    if a.is_empty() {
-        return f64::NAN;
-    }
-    a.sort_by(f64::total_cmp);
-    a[((q * a.len() as f64).ceil() as usize).clamp(1, a.len()) - 1]
 }
 
 /// The Markdown table of one sweep.

@@ -314,16 +314,7 @@ pub fn score(runs: &[TrialRun], pred: &Predictions) -> Vec<DatasetScores> {
         .collect()
 }
 
-/// Median (mean of the middle two for an even count), NaN when empty.
-fn median(v: &[f64]) -> f64 {
-    let mut a = v.to_vec();
-    a.sort_by(f64::total_cmp);
-    match a.len() {
-        0 => f64::NAN,
-        n if n % 2 == 1 => a[n / 2],
-        n => (a[n / 2 - 1] + a[n / 2]) / 2.0,
-    }
-}
+use crate::stats::median;
 
 /// The Markdown table: one row per model, per dataset RMSE / MAE / bias in cm and the
 /// walked-distance error (median / worst trial, %).

@@ -21,6 +21,7 @@ pub mod qemu;
 pub mod reference;
 pub mod replay;
 pub mod sim;
+pub mod stats;
 pub mod trace;
 pub mod train;
 pub mod zupt_sweep;

@@ -448,14 +448,6 @@ impl Trained {
     }
 }
 
-fn quantile(v: &mut [f64], q: f64) -> f64 {
-    v.sort_by(f64::total_cmp);
-    if v.is_empty() {
-        return 0.0;
-    }
-    v[((v.len() - 1) as f64 * q).round() as usize]
-}
-
 /// Least squares `min ‖A c − y‖` by SVD (minimum-norm when rank-deficient, as Zhang is
 /// when every walker has the default height).
 pub fn least_squares(
@@ -499,8 +491,11 @@ fn fit_linear(train: &[&Sample], lu: (f64, f64)) -> Result<[[f64; MAX_TERMS]; LI
 
 fn lu_range(train: &[&Sample]) -> (f64, f64) {
     let i = features::index(Segment::Movement, Channel::Vertical, features::Stat::Range);
-    let mut r: Vec<f64> = train.iter().map(|s| s.x[i]).collect();
-    (quantile(&mut r, 0.05), quantile(&mut r, 0.95))
+    let r: Vec<f64> = train.iter().map(|s| s.x[i]).collect();
+    (
+        crate::stats::quantile_at_rounded_index(&r, 0.05),
+        crate::stats::quantile_at_rounded_index(&r, 0.95),
+    )
 }
 
 fn mean_std(v: impl Iterator<Item = f64> + Clone) -> (f64, f64) {
