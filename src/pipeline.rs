@@ -525,37 +525,27 @@ impl<D: StepDetector> Pipeline<D> {
         }
     }
 
+    /// Counts hole `h` as what it became.
     fn count(&mut self, h: PendingHole) {
-        let c = &mut self.holes;
-        match h.origin {
-            Origin::Bridged => {
-                c.bridged = c.bridged.saturating_add(1);
-                c.bridged_samples = c.bridged_samples.saturating_add(h.missing);
-            }
-            Origin::Filled => {
-                c.filled = c.filled.saturating_add(1);
-                c.filled_samples = c.filled_samples.saturating_add(h.missing);
-            }
-            Origin::Measured => {}
+        self.tally(h, u32::saturating_add);
+    }
+
+    /// Takes back [`Pipeline::count`] of `h`: a pending hole grew into another kind.
+    fn uncount(&mut self, h: PendingHole) {
+        if h.missing > 0 {
+            self.tally(h, u32::saturating_sub);
         }
     }
 
-    fn uncount(&mut self, h: PendingHole) {
+    fn tally(&mut self, h: PendingHole, op: fn(u32, u32) -> u32) {
         let c = &mut self.holes;
-        if h.missing == 0 {
-            return;
-        }
-        match h.origin {
-            Origin::Bridged => {
-                c.bridged = c.bridged.saturating_sub(1);
-                c.bridged_samples = c.bridged_samples.saturating_sub(h.missing);
-            }
-            Origin::Filled => {
-                c.filled = c.filled.saturating_sub(1);
-                c.filled_samples = c.filled_samples.saturating_sub(h.missing);
-            }
-            Origin::Measured => {}
-        }
+        let (holes, samples) = match h.origin {
+            Origin::Bridged => (&mut c.bridged, &mut c.bridged_samples),
+            Origin::Filled => (&mut c.filled, &mut c.filled_samples),
+            Origin::Measured => return,
+        };
+        *holes = op(*holes, 1);
+        *samples = op(*samples, h.missing);
     }
 
     /// The hole is too long to interpolate: the detector drains and closes the stride as

@@ -715,7 +715,9 @@ impl<const M: usize> StepDetector for StanceStrides<M> {
         self.stance.reset();
         // In the order they closed; the first is handed back, the second waits in the
         // tracker (which `gap` emptied), a third here.
-        let mut closed = [self.held.take(), drained, self.tracker.gap()].into_iter().flatten();
+        let mut closed = [self.held.take(), drained, self.tracker.gap()]
+            .into_iter()
+            .flatten();
         let first = closed.next();
         if let Some(second) = closed.next() {
             self.tracker.hold(second);

@@ -12,13 +12,11 @@ mod nrf51_timer;
 
 use gaitclip_board::{replay_app, Steps};
 
-use cortex_m::peripheral::NVIC;
 use cortex_m_rt::{entry, exception};
 use defmt_semihosting as _;
 
 use gaitclip::pipeline::Pipeline;
-use nrf51_timer::{Nrf51Timer, TIMER0_BASE, TIMER0_IRQ};
-use replay_app::{Irq, SampleTimer};
+use nrf51_timer::Nrf51Timer;
 use static_cell::ConstStaticCell;
 
 /// The nRF51 core clock, 16 MHz.
@@ -30,18 +28,6 @@ const CYCLES_PER_US: u32 = 16;
 /// the M4 build with its 1 024.
 const MOVEMENT_SAMPLES: usize = 256;
 
-impl SampleTimer for Nrf51Timer {
-    fn start_periodic(&self, millihertz: u32) {
-        Nrf51Timer::start_periodic(self, millihertz);
-    }
-    fn stop(&self) {
-        Nrf51Timer::stop(self);
-    }
-    fn clear_interrupt(&self) {
-        Nrf51Timer::clear_interrupt(self);
-    }
-}
-
 /// The pipeline, built at compile time into .data: no copy of it ever sits on the stack
 /// (moving 8–12 KiB through the stack is more than a 16 KiB part can spare), and the stack
 /// holds only what one sample's processing needs.
@@ -51,20 +37,10 @@ static PIPELINE: ConstStaticCell<Pipeline<Steps<MOVEMENT_SAMPLES>>> = ConstStati
 
 #[entry]
 fn main() -> ! {
-    // Note(unsafe): TIMER0 is driven only through this value, from here and its handler.
-    let timer = unsafe { Nrf51Timer::new(TIMER0_BASE) };
-    let pipeline = PIPELINE.take();
-    replay_app::run(pipeline, "microbit", CYCLES_PER_US, &timer, || {
-        // Note(unsafe): the handler only touches state behind `Mutex`es and atomics, so
-        // unmasking cannot break a critical section.
-        unsafe { NVIC::unmask(Irq(TIMER0_IRQ)) }
-    })
+    replay_app::run::<_, Nrf51Timer>(PIPELINE.take(), "microbit", CYCLES_PER_US)
 }
 
 #[exception]
 unsafe fn DefaultHandler(irqn: i16) {
-    if irqn == TIMER0_IRQ as i16 {
-        // Note(unsafe): TIMER0 is only acknowledged and stopped here; `main` only started it.
-        replay_app::on_timer_interrupt(&unsafe { Nrf51Timer::new(TIMER0_BASE) });
-    }
+    replay_app::on_interrupt::<Nrf51Timer>(irqn);
 }

@@ -1,6 +1,9 @@
 //! TIMER0 of the nRF51 (nRF51 Series Reference Manual v3.0 §18), as QEMU's `microbit`
 //! machine models it: a 16 MHz timer with a prescaler and compare registers.
 
+use gaitclip_board::registers::Registers;
+use gaitclip_board::replay_app::SampleTimer;
+
 /// TIMER0 base address.
 pub const TIMER0_BASE: usize = 0x4000_8000;
 /// TIMER0's interrupt number.
@@ -25,48 +28,39 @@ const BITMODE_32: u32 = 3;
 /// PRESCALER 4: 16 MHz / 2⁴ = 1 MHz, 1 µs per tick.
 const PRESCALER_1MHZ: u32 = 4;
 
-/// One nRF51 timer.
-pub struct Nrf51Timer {
-    base: usize,
-}
+/// TIMER0, the sample timer.
+pub struct Nrf51Timer(Registers);
 
-impl Nrf51Timer {
-    /// The timer at `base`.
-    ///
-    /// # Safety
-    /// `base` must be a TIMER of this device, driven through no other value at the same
-    /// time (two values may exist when one only acknowledges events, as the handler does).
-    pub const unsafe fn new(base: usize) -> Self {
-        Nrf51Timer { base }
-    }
+impl SampleTimer for Nrf51Timer {
+    const IRQ: u16 = TIMER0_IRQ;
 
-    fn write(&self, offset: usize, value: u32) {
-        // Note(unsafe): `base + offset` is a register of this timer (see `new`), and a
-        // volatile write is how the peripheral is meant to be driven.
-        unsafe { core::ptr::write_volatile((self.base + offset) as *mut u32, value) }
+    unsafe fn steal() -> Self {
+        // Note(unsafe): TIMER0_BASE is TIMER0's register block; `replay_app` drives it
+        // through one value at a time, the handler only acknowledging events (the trait's
+        // contract).
+        Nrf51Timer(unsafe { Registers::new(TIMER0_BASE) })
     }
 
     /// Periodic COMPARE[0] interrupts at `millihertz` (1 µs resolution).
-    pub fn start_periodic(&self, millihertz: u32) {
+    fn start_periodic(&self, millihertz: u32) {
         let period_us = (1_000_000_000u64 / millihertz.max(1) as u64).max(1) as u32;
-        self.write(TASKS_STOP, 1);
-        self.write(MODE, 0);
-        self.write(BITMODE, BITMODE_32);
-        self.write(PRESCALER, PRESCALER_1MHZ);
-        self.write(CC0, period_us);
-        self.write(SHORTS, COMPARE0_CLEAR);
-        self.write(INTENSET, INT_COMPARE0);
-        self.write(TASKS_CLEAR, 1);
-        self.write(TASKS_START, 1);
+        self.0.write(TASKS_STOP, 1);
+        self.0.write(MODE, 0);
+        self.0.write(BITMODE, BITMODE_32);
+        self.0.write(PRESCALER, PRESCALER_1MHZ);
+        self.0.write(CC0, period_us);
+        self.0.write(SHORTS, COMPARE0_CLEAR);
+        self.0.write(INTENSET, INT_COMPARE0);
+        self.0.write(TASKS_CLEAR, 1);
+        self.0.write(TASKS_START, 1);
     }
 
-    /// Stops the timer.
-    pub fn stop(&self) {
-        self.write(TASKS_STOP, 1);
+    fn stop(&self) {
+        self.0.write(TASKS_STOP, 1);
     }
 
     /// Acknowledges the COMPARE[0] event.
-    pub fn clear_interrupt(&self) {
-        self.write(EVENTS_COMPARE0, 0);
+    fn clear_interrupt(&self) {
+        self.0.write(EVENTS_COMPARE0, 0);
     }
 }

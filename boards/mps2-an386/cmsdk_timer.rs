@@ -1,5 +1,8 @@
 //! The CMSDK APB timer of the MPS2 FPGA images (ARM DDI 0479C §4.4), as QEMU models it.
 
+use gaitclip_board::registers::Registers;
+use gaitclip_board::replay_app::SampleTimer;
+
 /// TIMER0 base address on AN385/AN386.
 pub const TIMER0_BASE: usize = 0x4000_0000;
 /// TIMER0's interrupt number (external IRQ 8 on AN385/AN386).
@@ -14,45 +17,35 @@ const INTCLEAR: usize = 0x0C;
 const CTRL_ENABLE: u32 = 1 << 0;
 const CTRL_IRQ_ENABLE: u32 = 1 << 3;
 
-/// One CMSDK timer.
-pub struct CmsdkTimer {
-    base: usize,
-}
+/// TIMER0, the sample timer.
+pub struct CmsdkTimer(Registers);
 
-impl CmsdkTimer {
-    /// The timer at `base`.
-    ///
-    /// # Safety
-    /// `base` must be the address of a CMSDK APB timer that nothing else drives.
-    pub const unsafe fn new(base: usize) -> Self {
-        CmsdkTimer { base }
-    }
+impl SampleTimer for CmsdkTimer {
+    const IRQ: u16 = TIMER0_IRQ;
 
-    fn write(&self, offset: usize, v: u32) {
-        // Note(unsafe): `base` is a CMSDK timer owned by this value (constructor contract);
-        // the offsets are its documented 32-bit registers.
-        unsafe { core::ptr::write_volatile((self.base + offset) as *mut u32, v) }
+    unsafe fn steal() -> Self {
+        // Note(unsafe): TIMER0_BASE is TIMER0's register block; `replay_app` drives it
+        // through one value at a time (the trait's contract).
+        CmsdkTimer(unsafe { Registers::new(TIMER0_BASE) })
     }
 
     /// Starts periodic interrupts at `rate_millihertz` (the period is rounded to whole clock
     /// cycles: 125 000 cycles at 200 Hz, exact).
-    pub fn start_periodic(&self, rate_millihertz: u32) {
+    fn start_periodic(&self, rate_millihertz: u32) {
         let cycles = (PCLK_HZ * 1000 + rate_millihertz as u64 / 2) / rate_millihertz.max(1) as u64;
         let reload = cycles.saturating_sub(1).min(u32::MAX as u64) as u32;
-        self.write(CTRL, 0);
-        self.write(RELOAD, reload);
-        self.write(VALUE, reload);
-        self.write(INTCLEAR, 1);
-        self.write(CTRL, CTRL_ENABLE | CTRL_IRQ_ENABLE);
+        self.0.write(CTRL, 0);
+        self.0.write(RELOAD, reload);
+        self.0.write(VALUE, reload);
+        self.0.write(INTCLEAR, 1);
+        self.0.write(CTRL, CTRL_ENABLE | CTRL_IRQ_ENABLE);
     }
 
-    /// Acknowledges the interrupt.
-    pub fn clear_interrupt(&self) {
-        self.write(INTCLEAR, 1);
+    fn clear_interrupt(&self) {
+        self.0.write(INTCLEAR, 1);
     }
 
-    /// Stops the timer.
-    pub fn stop(&self) {
-        self.write(CTRL, 0);
+    fn stop(&self) {
+        self.0.write(CTRL, 0);
     }
 }

@@ -17,16 +17,15 @@
 #![no_std]
 #![no_main]
 
-use gaitclip_board::{imu_sampler, live_app, startup, stride_log, Steps};
+use gaitclip_board::{imu_sampler, live_app, stride_log, Steps};
 
 use core::cell::RefCell;
 
 use cortex_m::interrupt::{self as irq, Mutex};
 use cortex_m_rt::entry;
 use defmt_rtt as _;
-use embedded_hal::delay::DelayNs;
 use embedded_hal::i2c::{ErrorType, I2c, Operation, SevenBitAddress};
-use gaitclip::mpu6050::{self, Address, Mpu6050, OutputRate};
+use gaitclip::mpu6050::{self, Address, Mpu6050};
 use gaitclip::pipeline::{Config, Pipeline};
 use gaitclip::rate::SampleRate;
 use gaitclip::sample::{AccelRange, GyroRange};
@@ -45,8 +44,7 @@ use panic_probe as _;
 use static_cell::ConstStaticCell;
 
 use imu_sampler::{BusRecovery, Item, ReadMode};
-use live_app::{SampleLink, Watchdog, WATCHDOG_TICK_MS};
-use startup::Startup;
+use live_app::{SampleLink, SpinDelay, Watchdog, WATCHDOG_TICK_MS};
 use stride_log::StrideLog;
 
 /// Output data rate of the sensor.
@@ -57,18 +55,10 @@ const FIFO_BATCH: u8 = 8;
 const QUEUE_LEN: usize = 128;
 const ACCEL: AccelRange = AccelRange::G16;
 const GYRO: GyroRange = GyroRange::Dps2000;
-const RATE: SampleRate = match SampleRate::from_hz(RATE_HZ as u32) {
-    Some(r) => r,
-    None => panic!("unsupported rate"),
-};
-const SENSOR: mpu6050::Config = mpu6050::Config {
-    rate: match OutputRate::from_hz(RATE_HZ) {
-        Some(r) => r,
-        None => panic!("unsupported output rate"),
-    },
-    accel: ACCEL,
-    gyro: GYRO,
-};
+/// The core clock, 64 MHz.
+const CYCLES_PER_US: u32 = 64;
+const RATE: SampleRate = live_app::sample_rate(RATE_HZ);
+const SENSOR: mpu6050::Config = live_app::sensor_config(RATE_HZ, ACCEL, GYRO);
 
 /// TWIM0 that can give its pins back to clock a stuck bus free.
 struct RecoverableTwim {
@@ -103,14 +93,7 @@ impl BusRecovery for RecoverableTwim {
         let mut scl = pins
             .scl
             .into_open_drain_output(OpenDrainConfig::Standard0Disconnect1, Level::High);
-        // Nine clocks let a slave finish the byte it is sending and see a NACK; 5 µs half
-        // periods (100 kHz) at 64 MHz.
-        for _ in 0..9 {
-            let _ = embedded_hal::digital::OutputPin::set_low(&mut scl);
-            cortex_m::asm::delay(320);
-            let _ = embedded_hal::digital::OutputPin::set_high(&mut scl);
-            cortex_m::asm::delay(320);
-        }
+        live_app::clock_bus_free(&mut scl, CYCLES_PER_US);
         let scl: Pin<Input<Floating>> = scl.into_floating_input();
         self.twim = Some(Twim::new(
             periph,
@@ -118,15 +101,6 @@ impl BusRecovery for RecoverableTwim {
             twim::Frequency::K400,
         ));
         true
-    }
-}
-
-/// Busy-wait delay (the sensor's 100 ms reset) at 64 MHz.
-struct SpinDelay;
-
-impl DelayNs for SpinDelay {
-    fn delay_ns(&mut self, ns: u32) {
-        cortex_m::asm::delay((ns / 1000).saturating_mul(64).max(1));
     }
 }
 
@@ -178,16 +152,12 @@ fn main() -> ! {
             twim::Frequency::K400,
         )),
     };
-    let sampler = live_app::start_sensor(
-        Mpu6050::new(bus, Address::Ad0Low),
-        SpinDelay,
-        SENSOR,
-        ReadMode::Fifo { batch: FIFO_BATCH },
-        &mut serial,
-    );
-
-    let (producer, mut consumer) = QUEUE.take().split();
-    LINK.install(sampler, producer);
+    let delay = SpinDelay {
+        cycles_per_us: CYCLES_PER_US,
+    };
+    let imu = Mpu6050::new(bus, Address::Ad0Low);
+    let mode = ReadMode::Fifo { batch: FIFO_BATCH };
+    let consumer = LINK.start(imu, delay, SENSOR, mode, QUEUE.take(), &mut serial);
     let int_pin = port0.p0_03.into_floating_input().degrade();
     let gpiote = Gpiote::new(p.GPIOTE);
     gpiote
@@ -209,16 +179,7 @@ fn main() -> ! {
         pac::NVIC::unmask(pac::Interrupt::TIMER1);
     }
 
-    let mut startup = Startup::new(RATE, GYRO);
-    live_app::main_loop(
-        PIPELINE.take(),
-        &mut consumer,
-        &mut log,
-        &mut serial,
-        &mut startup,
-        || LINK.counters(),
-        RATE.samples_in_ms(live_app::STATUS_EVERY_MS),
-    )
+    LINK.main_loop(PIPELINE.take(), &CONFIG, consumer, &mut log, &mut serial)
 }
 
 #[interrupt]

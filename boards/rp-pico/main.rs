@@ -15,17 +15,15 @@
 #![no_std]
 #![no_main]
 
-use gaitclip_board::{imu_sampler, live_app, startup, stride_log, Steps};
+use gaitclip_board::{imu_sampler, live_app, stride_log, Steps};
 
 use core::cell::RefCell;
 
 use cortex_m::interrupt::{self as irq, Mutex};
 use defmt_rtt as _;
-use embedded_hal::delay::DelayNs;
-use embedded_hal::digital::OutputPin;
 use embedded_hal::i2c::{ErrorType, I2c, Operation, SevenBitAddress};
 use fugit::{HertzU32, RateExtU32};
-use gaitclip::mpu6050::{self, Address, Mpu6050, OutputRate};
+use gaitclip::mpu6050::{self, Address, Mpu6050};
 use gaitclip::pipeline::{Config, Pipeline};
 use gaitclip::rate::SampleRate;
 use gaitclip::sample::{AccelRange, GyroRange};
@@ -48,8 +46,7 @@ use rp2040_hal::{
 use static_cell::ConstStaticCell;
 
 use imu_sampler::{BusRecovery, Item, ReadMode};
-use live_app::{SampleLink, Watchdog as SensorWatchdog, WATCHDOG_TICK_MS};
-use startup::Startup;
+use live_app::{SampleLink, SpinDelay, Watchdog as SensorWatchdog, WATCHDOG_TICK_MS};
 use stride_log::StrideLog;
 
 /// The second-stage bootloader for the Pico's W25Q080 flash.
@@ -67,18 +64,10 @@ const FIFO_BATCH: u8 = 8;
 const QUEUE_LEN: usize = 128;
 const ACCEL: AccelRange = AccelRange::G16;
 const GYRO: GyroRange = GyroRange::Dps2000;
-const RATE: SampleRate = match SampleRate::from_hz(RATE_HZ as u32) {
-    Some(r) => r,
-    None => panic!("unsupported rate"),
-};
-const SENSOR: mpu6050::Config = mpu6050::Config {
-    rate: match OutputRate::from_hz(RATE_HZ) {
-        Some(r) => r,
-        None => panic!("unsupported output rate"),
-    },
-    accel: ACCEL,
-    gyro: GYRO,
-};
+/// The system clock, 125 MHz.
+const CYCLES_PER_US: u32 = 125;
+const RATE: SampleRate = live_app::sample_rate(RATE_HZ);
+const SENSOR: mpu6050::Config = live_app::sensor_config(RATE_HZ, ACCEL, GYRO);
 
 type Sda = Pin<Gpio4, FunctionI2C, PullUp>;
 type Scl = Pin<Gpio5, FunctionI2C, PullUp>;
@@ -117,14 +106,7 @@ impl BusRecovery for RecoverableI2c {
         };
         let (block, (sda, scl)) = i2c.free(&mut self.resets);
         let mut scl = scl.into_push_pull_output();
-        // Nine clocks let a slave finish the byte it is sending and see a NACK; 5 µs half
-        // periods (100 kHz) at 125 MHz.
-        for _ in 0..9 {
-            let _ = scl.set_low();
-            cortex_m::asm::delay(625);
-            let _ = scl.set_high();
-            cortex_m::asm::delay(625);
-        }
+        live_app::clock_bus_free(&mut scl, CYCLES_PER_US);
         let scl: Scl = scl.into_function();
         self.i2c = Some(hal::I2C::i2c0(
             block,
@@ -135,15 +117,6 @@ impl BusRecovery for RecoverableI2c {
             self.system_clock,
         ));
         true
-    }
-}
-
-/// Busy-wait delay (the sensor's 100 ms reset) at 125 MHz.
-struct SpinDelay;
-
-impl DelayNs for SpinDelay {
-    fn delay_ns(&mut self, ns: u32) {
-        cortex_m::asm::delay((ns / 1000).saturating_mul(125).max(1));
     }
 }
 
@@ -205,16 +178,12 @@ fn main() -> ! {
         resets: pac.RESETS,
         system_clock,
     };
-    let sampler = live_app::start_sensor(
-        Mpu6050::new(bus, Address::Ad0Low),
-        SpinDelay,
-        SENSOR,
-        ReadMode::Fifo { batch: FIFO_BATCH },
-        &mut serial,
-    );
-
-    let (producer, mut consumer) = QUEUE.take().split();
-    LINK.install(sampler, producer);
+    let delay = SpinDelay {
+        cycles_per_us: CYCLES_PER_US,
+    };
+    let imu = Mpu6050::new(bus, Address::Ad0Low);
+    let mode = ReadMode::Fifo { batch: FIFO_BATCH };
+    let consumer = LINK.start(imu, delay, SENSOR, mode, QUEUE.take(), &mut serial);
     let int_pin: IntPin = pins.gpio6.into_pull_down_input();
     int_pin.set_interrupt_enabled(PinInterrupt::EdgeHigh, true);
     let Some(mut alarm) = timer.alarm_0() else {
@@ -235,16 +204,7 @@ fn main() -> ! {
         pac::NVIC::unmask(pac::Interrupt::TIMER_IRQ_0);
     }
 
-    let mut startup = Startup::new(RATE, GYRO);
-    live_app::main_loop(
-        PIPELINE.take(),
-        &mut consumer,
-        &mut log,
-        &mut serial,
-        &mut startup,
-        || LINK.counters(),
-        RATE.samples_in_ms(live_app::STATUS_EVERY_MS),
-    )
+    LINK.main_loop(PIPELINE.take(), &CONFIG, consumer, &mut log, &mut serial)
 }
 
 #[interrupt]

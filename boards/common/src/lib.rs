@@ -12,7 +12,8 @@
 //! - [`replay_mpu6050`] and [`replay_holes`]: an MPU6050 on an emulated I²C bus serving a
 //!   stored trace, for the QEMU boards and the host tests.
 //! - On a Cortex-M only: `live_app` (the main loop of a board with a real sensor),
-//!   `stride_log` (defmt and the serial line), and with the `replay` feature
+//!   `stride_log` (defmt and the serial line), `registers` (memory-mapped peripherals),
+//!   and with the `replay` feature
 //!   `replay_app` (the QEMU firmware) and `stack_paint` (the stack's high-water mark).
 //!
 //! The parts above `live_app` build on the host, where `tests-host` checks them against
@@ -48,6 +49,8 @@ pub mod startup;
 
 #[cfg(target_os = "none")]
 pub mod live_app;
+#[cfg(target_os = "none")]
+pub mod registers;
 #[cfg(all(target_os = "none", feature = "replay"))]
 pub mod replay_app;
 #[cfg(all(target_os = "none", feature = "replay"))]

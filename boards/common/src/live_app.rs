@@ -12,13 +12,14 @@ use core::sync::atomic::{AtomicU32, Ordering};
 
 use cortex_m::interrupt::{self as irq, Mutex};
 use embedded_hal::delay::DelayNs;
+use embedded_hal::digital::OutputPin;
 use embedded_hal::i2c::I2c;
 use gaitclip::detector::StepDetector;
 use gaitclip::mpu6050::{self, Mpu6050};
 use gaitclip::pipeline::{Config, Pipeline};
 use gaitclip::rate::SampleRate;
 use gaitclip::sample::{AccelRange, GyroRange};
-use heapless::spsc::{Consumer, Producer};
+use heapless::spsc::{Consumer, Producer, Queue};
 
 use crate::imu_sampler::{BusRecovery, Counters, ImuSampler, Item, ReadMode};
 use crate::serial_line;
@@ -74,6 +75,23 @@ where
         }
     }
 
+    /// Starts the sensor ([`start_sensor`]), hands the sampler and `queue`'s producer to
+    /// the interrupts, and returns the queue's consumer for the main loop.
+    pub fn start<const N: usize>(
+        &self,
+        imu: Mpu6050<I>,
+        delay: D,
+        config: mpu6050::Config,
+        mode: ReadMode,
+        queue: &'static mut Queue<Item, N>,
+        serial: &mut impl Write,
+    ) -> Consumer<'static, Item> {
+        let sampler = start_sensor(imu, delay, config, mode, serial);
+        let (producer, consumer) = queue.split();
+        self.install(sampler, producer);
+        consumer
+    }
+
     /// Hands the started sampler and the queue's producer to the interrupts.
     pub fn install(&self, sampler: ImuSampler<I, D>, producer: Producer<'static, Item>) {
         irq::free(|cs| {
@@ -111,6 +129,55 @@ where
     pub fn on_watchdog_tick(&self, watchdog: &mut Watchdog, periods_per_tick: u32) {
         if let Some(lost) = watchdog.tick(self.pulses(), periods_per_tick) {
             self.with(|s, mut push| s.on_silence(lost, &mut push));
+        }
+    }
+
+    /// Processes the queue forever, reporting start-up ([`Startup`]), strides, gaps and a
+    /// status line (with the sampler's fault counters) every [`STATUS_EVERY_MS`].
+    pub fn main_loop<S: StepDetector>(
+        &self,
+        pipeline: &mut Pipeline<S>,
+        config: &Config,
+        mut consumer: Consumer<'static, Item>,
+        log: &mut StrideLog,
+        serial: &mut impl Write,
+    ) -> ! {
+        let status_every_samples = config.rate.samples_in_ms(STATUS_EVERY_MS);
+        let mut startup = Startup::new(config.rate, config.gyro);
+        let mut samples = 0u32;
+        let mut next_status = status_every_samples;
+        loop {
+            while let Some(item) = consumer.dequeue() {
+                let stride = item.feed(pipeline);
+                if let Item::Sample(_) = item {
+                    samples = samples.wrapping_add(1);
+                    if let Some(e) = startup.update(pipeline) {
+                        log.startup(e, serial);
+                    }
+                }
+                // A stride a gap hands back was closed before it: it comes first.
+                if let Some(stride) = &stride {
+                    log.stride(stride, serial);
+                }
+                match item {
+                    Item::Sample(_) if samples == next_status => {
+                        next_status = next_status.wrapping_add(status_every_samples);
+                        log.summary(samples, &self.counters(), serial);
+                    }
+                    Item::Sample(_) => {}
+                    Item::Gap(n) => log.gap(n, pipeline.hole_kind(n), serial),
+                }
+            }
+            // Interrupts are masked while checking the queue so that a sample arriving between
+            // the check and `wfi` still wakes the core (WFI wakes on a pending interrupt even
+            // with PRIMASK set).
+            irq::disable();
+            if !consumer.ready() {
+                cortex_m::asm::wfi();
+            }
+            // Note(unsafe): re-enables the interrupts disabled just above; no critical section
+            // spans this point.
+            unsafe { irq::enable() };
         }
     }
 
@@ -196,50 +263,47 @@ impl Default for Watchdog {
     }
 }
 
-/// Processes the queue forever. `counters` reads the sampler's fault counters (inside a
-/// critical section, as the interrupt owns the sampler).
-pub fn main_loop<D: StepDetector>(
-    pipeline: &mut Pipeline<D>,
-    consumer: &mut Consumer<'static, Item>,
-    log: &mut StrideLog,
-    serial: &mut impl Write,
-    startup: &mut Startup,
-    counters: impl Fn() -> Counters,
-    status_every_samples: u32,
-) -> ! {
-    let mut samples = 0u32;
-    let mut next_status = status_every_samples;
-    loop {
-        while let Some(item) = consumer.dequeue() {
-            let stride = item.feed(pipeline);
-            if let Item::Sample(_) = item {
-                samples = samples.wrapping_add(1);
-                if let Some(e) = startup.update(pipeline) {
-                    log.startup(e, serial);
-                }
-            }
-            // A stride a gap hands back was closed before it: it comes first.
-            if let Some(stride) = &stride {
-                log.stride(stride, serial);
-            }
-            match item {
-                Item::Sample(_) if samples == next_status => {
-                    next_status = next_status.wrapping_add(status_every_samples);
-                    log.summary(samples, &counters(), serial);
-                }
-                Item::Sample(_) => {}
-                Item::Gap(n) => log.gap(n, pipeline.hole_kind(n), serial),
-            }
-        }
-        // Interrupts are masked while checking the queue so that a sample arriving between
-        // the check and `wfi` still wakes the core (WFI wakes on a pending interrupt even
-        // with PRIMASK set).
-        irq::disable();
-        if !consumer.ready() {
-            cortex_m::asm::wfi();
-        }
-        // Note(unsafe): re-enables the interrupts disabled just above; no critical section
-        // spans this point.
-        unsafe { irq::enable() };
+/// The sample rate of a sensor output rate in Hz (checked at compile time).
+pub const fn sample_rate(hz: u16) -> SampleRate {
+    match SampleRate::from_hz(hz as u32) {
+        Some(r) => r,
+        None => panic!("unsupported rate"),
+    }
+}
+
+/// The MPU6050's configuration for an output rate in Hz and the ranges (checked at compile
+/// time).
+pub const fn sensor_config(hz: u16, accel: AccelRange, gyro: GyroRange) -> mpu6050::Config {
+    mpu6050::Config {
+        rate: match mpu6050::OutputRate::from_hz(hz) {
+            Some(r) => r,
+            None => panic!("unsupported output rate"),
+        },
+        accel,
+        gyro,
+    }
+}
+
+/// Busy-wait delay (the sensor's 100 ms reset): a busy loop is honest about what it costs.
+pub struct SpinDelay {
+    /// Core clock, cycles per µs.
+    pub cycles_per_us: u32,
+}
+
+impl DelayNs for SpinDelay {
+    fn delay_ns(&mut self, ns: u32) {
+        cortex_m::asm::delay((ns / 1000).saturating_mul(self.cycles_per_us).max(1));
+    }
+}
+
+/// Clocks a stuck I²C bus free on its SCL pin, taken as a GPIO output: nine clocks let a
+/// slave finish the byte it is sending and see a NACK; 5 µs half periods (100 kHz) at
+/// `cycles_per_us`.
+pub fn clock_bus_free(scl: &mut impl OutputPin, cycles_per_us: u32) {
+    for _ in 0..9 {
+        let _ = scl.set_low();
+        cortex_m::asm::delay(5 * cycles_per_us);
+        let _ = scl.set_high();
+        cortex_m::asm::delay(5 * cycles_per_us);
     }
 }

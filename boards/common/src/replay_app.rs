@@ -12,7 +12,6 @@ use core::sync::atomic::{AtomicBool, Ordering};
 
 use cortex_m::interrupt as irq;
 use cortex_m_semihosting::debug::{self, EXIT_FAILURE, EXIT_SUCCESS};
-use embedded_hal::delay::DelayNs;
 use gaitclip::detector::StepDetector;
 use gaitclip::mpu6050::{self, Address, Mpu6050};
 use gaitclip::pipeline::{Config, Pipeline};
@@ -21,7 +20,7 @@ use gaitclip::sample::{AccelRange, GyroRange, SAMPLE_BYTES};
 use heapless::spsc::Queue;
 
 use crate::imu_sampler::{ImuSampler, Item, ReadMode};
-use crate::live_app::SampleLink;
+use crate::live_app::{SampleLink, SpinDelay};
 use crate::replay_mpu6050::ReplayMpu6050;
 use crate::startup::Startup;
 use crate::stride_log::{NoSerial, StrideLog};
@@ -54,33 +53,23 @@ const ACCEL: AccelRange = unwrap(AccelRange::from_afs_sel(trace::ACCEL_AFS_SEL))
 const GYRO: GyroRange = unwrap(GyroRange::from_fs_sel(trace::GYRO_FS_SEL));
 /// The pipeline's configuration for the stored trace.
 pub const CONFIG: Config = crate::live_app::config(RATE, ACCEL, GYRO);
-const SENSOR: mpu6050::Config = mpu6050::Config {
-    rate: unwrap(mpu6050::OutputRate::from_hz(
-        (trace::RATE_MILLIHERTZ / 1000) as u16,
-    )),
-    accel: ACCEL,
-    gyro: GYRO,
-};
-
-/// Busy-wait delay for the sensor's reset time; the emulated sensor needs none, a real one
-/// 100 ms, and a busy loop is honest about what it costs.
-pub struct SpinDelay {
-    /// Core clock, cycles per µs.
-    pub cycles_per_us: u32,
-}
-
-impl DelayNs for SpinDelay {
-    fn delay_ns(&mut self, ns: u32) {
-        cortex_m::asm::delay((ns / 1000).saturating_mul(self.cycles_per_us).max(1));
-    }
-}
+const SENSOR: mpu6050::Config =
+    crate::live_app::sensor_config((trace::RATE_MILLIHERTZ / 1000) as u16, ACCEL, GYRO);
 
 /// Sampler, queue producer and pulse count, shared by the timer interrupt and the main loop.
 static LINK: SampleLink<ReplayMpu6050, SpinDelay> = SampleLink::new();
 static TRACE_DONE: AtomicBool = AtomicBool::new(false);
 
 /// The board's sample timer.
-pub trait SampleTimer {
+pub trait SampleTimer: Sized {
+    /// Its external interrupt number.
+    const IRQ: u16;
+    /// The timer, for `main` and for its interrupt handler.
+    ///
+    /// # Safety
+    /// Only [`run`] (once) and [`on_interrupt`] may call it: `run` drives the timer, the
+    /// handler only acknowledges and stops it.
+    unsafe fn steal() -> Self;
     /// Starts periodic interrupts at `millihertz`.
     fn start_periodic(&self, millihertz: u32);
     /// Stops them.
@@ -91,10 +80,10 @@ pub trait SampleTimer {
 
 /// An external interrupt number of the board, for the NVIC.
 #[derive(Clone, Copy)]
-pub struct Irq(pub u16);
+struct Irq(u16);
 
-// Note(unsafe): the boards construct `Irq` only with their timer's interrupt number, which
-// is a valid external interrupt of the device (both have 32).
+// Note(unsafe): `Irq` is made only of a timer's `SampleTimer::IRQ`, a valid external
+// interrupt of its device (both QEMU boards have 32).
 unsafe impl cortex_m::interrupt::InterruptNumber for Irq {
     fn number(self) -> u16 {
         self.0
@@ -102,14 +91,14 @@ unsafe impl cortex_m::interrupt::InterruptNumber for Irq {
 }
 
 /// Runs the trace through `pipeline` (made from [`CONFIG`]; the board keeps it in a static,
-/// sized for its RAM) and exits QEMU. `unmask` enables the timer's interrupt in the NVIC.
-pub fn run<D: StepDetector>(
+/// sized for its RAM) with the timer `T` pulsing at the trace's rate, and exits QEMU.
+pub fn run<D: StepDetector, T: SampleTimer>(
     pipeline: &mut Pipeline<D>,
     board: &str,
     cycles_per_us: u32,
-    timer: &impl SampleTimer,
-    unmask: impl FnOnce(),
 ) -> ! {
+    // Note(unsafe): `run` is the one caller besides the handler (`SampleTimer::steal`).
+    let timer = unsafe { T::steal() };
     let imu = Mpu6050::new(
         ReplayMpu6050::new(Address::Ad0Low.bits(), trace::REGISTERS, LOST),
         Address::Ad0Low,
@@ -139,7 +128,9 @@ pub fn run<D: StepDetector>(
     let (producer, mut consumer) = queue.split();
     LINK.install(sampler, producer);
     timer.start_periodic(trace::RATE_MILLIHERTZ);
-    unmask();
+    // Note(unsafe): the handler only touches state behind `Mutex`es and atomics, so
+    // unmasking cannot break a critical section.
+    unsafe { cortex_m::peripheral::NVIC::unmask(Irq(T::IRQ)) };
 
     let mut startup = Startup::new(RATE, GYRO);
     let mut samples = 0u32;
@@ -209,9 +200,17 @@ fn finish<D: StepDetector>(pipeline: &mut Pipeline<D>, log: &mut StrideLog, samp
     cortex_m::asm::udf()
 }
 
-/// The body of the board timer's interrupt: one data-ready pulse of the emulated sensor,
-/// or, once the trace has been served, the end of the run (the timer stops).
-pub fn on_timer_interrupt(timer: &impl SampleTimer) {
+/// The body of the board's `DefaultHandler`: for the timer's interrupt, one data-ready
+/// pulse of the emulated sensor, or, once the trace has been served, the end of the run (the
+/// timer stops).
+pub fn on_interrupt<T: SampleTimer>(irqn: i16) {
+    if irqn == T::IRQ as i16 {
+        // Note(unsafe): the handler only acknowledges and stops the timer (`steal`).
+        on_timer_interrupt(&unsafe { T::steal() });
+    }
+}
+
+fn on_timer_interrupt(timer: &impl SampleTimer) {
     timer.clear_interrupt();
     if LINK.pulses() >= TRACE_SAMPLES {
         TRACE_DONE.store(true, Ordering::Release);
