@@ -54,8 +54,9 @@ use crate::phase_stats::{StrideStats, CHANNELS};
 use crate::phases::{self, PhaseMethod};
 use crate::pipeline::Config;
 use crate::rate::SampleRate;
-use crate::sample::{AccelRange, GyroRange, RawSample};
+use crate::sample::RawSample;
 use crate::stride::{magnitude_minus_g, Origin, Stride, StrideFlags, MAX_STANCE_IN_STRIDE_MS};
+use crate::units::{AccelScale, FootAccel, GyroScale};
 use crate::zupt::{RollingContact, ZuptIntegrator};
 
 /// Energy window, ms (5 samples at 100 Hz, as SHOE's; 11 at 200 Hz).
@@ -131,8 +132,8 @@ impl CycleConfig {
     /// `sensor_height_um` above the foot's rolling contact ([`SENSOR_HEIGHT_UM`]).
     pub const fn new(
         rate: SampleRate,
-        accel: AccelRange,
-        gyro: GyroRange,
+        accel: AccelScale,
+        gyro: GyroScale,
         phases: PhaseMethod,
         sensor_height_um: u32,
     ) -> Self {
@@ -427,7 +428,7 @@ impl<const M: usize> CycleDetector<M> {
         newest: &RawSample,
         at: u32,
         s: &RawSample,
-        foot: [i16; 3],
+        foot: FootAccel,
         origin: Origin,
         cal: &Calibration,
         out: &mut Option<Stride>,
@@ -460,7 +461,7 @@ impl<const M: usize> CycleDetector<M> {
         i: u32,
         t: u64,
         s: &RawSample,
-        foot: [i16; 3],
+        foot: FootAccel,
         origin: Origin,
         cal: &Calibration,
         out: &mut Option<Stride>,
@@ -522,7 +523,7 @@ impl<const M: usize> CycleDetector<M> {
             // Full: what is lost is counted when the stride closes (too long).
             let _ = self
                 .movement
-                .push([foot[2], foot[0], magnitude_minus_g(foot)]);
+                .push([foot.up(), foot.forward(), magnitude_minus_g(foot)]);
         }
         self.peak = self.peak.max(t);
         self.peak_since_cand = self.peak_since_cand.max(t);

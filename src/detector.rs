@@ -24,6 +24,7 @@ use crate::phase_stats::StrideStats;
 use crate::pipeline::{Config, DELAY_CAPACITY};
 use crate::sample::RawSample;
 use crate::stride::{Origin, Stride};
+use crate::units::FootAccel;
 
 /// The delay lines: the last [`DELAY_CAPACITY`] raw samples' accelerations and angular
 /// rates (no temperature: no stage after the delay reads it), their mean-filtered foot-frame
@@ -33,7 +34,7 @@ use crate::stride::{Origin, Stride};
 pub struct DelayLines {
     accel: [[i16; 3]; DELAY_CAPACITY],
     gyro: [[i16; 3]; DELAY_CAPACITY],
-    foot: [[i16; 3]; DELAY_CAPACITY],
+    foot: [FootAccel; DELAY_CAPACITY],
     /// One bit per slot: the sample was interpolated ([`Origin::Bridged`]).
     bridged: u128,
     /// One bit per slot: the sample was interpolated ([`Origin::Filled`]).
@@ -48,7 +49,7 @@ impl DelayLines {
         DelayLines {
             accel: [[0; 3]; DELAY_CAPACITY],
             gyro: [[0; 3]; DELAY_CAPACITY],
-            foot: [[0; 3]; DELAY_CAPACITY],
+            foot: [FootAccel([0; 3]); DELAY_CAPACITY],
             bridged: 0,
             filled: 0,
         }
@@ -69,7 +70,7 @@ impl DelayLines {
     }
 
     /// Stores the mean-filtered foot-frame value computed when sample `index` was fed.
-    pub fn set_foot(&mut self, index: u32, foot: [i16; 3]) {
+    pub fn set_foot(&mut self, index: u32, foot: FootAccel) {
         self.foot[slot(index)] = foot;
     }
 
@@ -83,7 +84,7 @@ impl DelayLines {
     }
 
     /// The foot-frame value computed when sample `at` was fed.
-    pub const fn foot(&self, at: u32) -> [i16; 3] {
+    pub const fn foot(&self, at: u32) -> FootAccel {
         self.foot[slot(at)]
     }
 
@@ -121,7 +122,7 @@ pub struct Input<'a> {
     pub origin: Origin,
     /// Its mean filter's output in the foot frame, `[forward, left, up − g]` (g/2048): the
     /// mean of a window centred [`Input::filter_delay`] samples back.
-    pub foot: [i16; 3],
+    pub foot: FootAccel,
     /// Samples by which the mean filter delays.
     pub filter_delay: u32,
     /// Inputs since the last restart (start or a long hole).

@@ -26,7 +26,8 @@ use nalgebra::{Matrix3, SymmetricEigen, Vector3};
 
 use crate::rate::SampleRate;
 use crate::rest::RestSums;
-use crate::sample::{AccelRange, GyroRange, RawSample};
+use crate::sample::RawSample;
+use crate::units::{AccelScale, FootAccel, GyroScale};
 
 /// A rest period whose gravity direction is further than this from the current up axis
 /// means the clip was moved: the frame starts again.
@@ -82,7 +83,7 @@ impl FootFrame {
     ///
     /// Error: the Q14 matrix is within 2⁻¹⁵ per entry of the `f32` rotation, so the result
     /// is within 1 unit (0.5 mg) plus rounding of the exact rotation for any `i16` input.
-    pub fn apply(&self, accel: [i16; 3]) -> [i16; 3] {
+    pub fn apply(&self, accel: [i16; 3]) -> FootAccel {
         let mut out = [0i16; 3];
         for (k, (o, row)) in out.iter_mut().zip(self.rows.iter()).enumerate() {
             // |row| ≤ 2¹⁴·√(Σ) per axis and |a| ≤ 2¹⁵: each product < 2²⁹, the sum < 2³¹.
@@ -97,11 +98,11 @@ impl FootFrame {
             }
             *o = v.clamp(-32_767, 32_767) as i16;
         }
-        out
+        FootAccel(out)
     }
 
     /// The rotation as rows of `f32` unit vectors (forward, left, up), for logs and tests.
-    pub fn axes(&self, accel: AccelRange) -> [[f32; 3]; 3] {
+    pub fn axes(&self, accel: AccelScale) -> [[f32; 3]; 3] {
         let scale = (1u32 << 14) as f32 * FOOT_LSB_PER_G as f32 / accel.lsb_per_g() as f32;
         self.rows.map(|r| r.map(|v| v as f32 / scale))
     }
@@ -137,7 +138,7 @@ struct StillBlock {
 /// Learns the foot frame from rest periods and movements.
 #[derive(Clone, Debug)]
 pub struct FootFrameEstimator {
-    accel: AccelRange,
+    accel: AccelScale,
     axis_min: u32,
     axis_max: u32,
     first_after: u32,
@@ -167,7 +168,7 @@ pub struct FootFrameEstimator {
 
 impl FootFrameEstimator {
     /// An estimator that knows nothing yet.
-    pub const fn new(rate: SampleRate, accel: AccelRange, gyro: GyroRange) -> Self {
+    pub const fn new(rate: SampleRate, accel: AccelScale, gyro: GyroScale) -> Self {
         let still_std = gyro.counts_of_mrad_per_s(STILL_GYRO_STD_MRADPS) as u64;
         FootFrameEstimator {
             accel,

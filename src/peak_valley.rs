@@ -814,10 +814,10 @@ impl StepDetector for PeakValleySteps {
         if out.is_none() {
             *out = self
                 .peaks
-                .process(at, x.foot[2])
+                .process(at, x.foot.up())
                 .map(|s| self.measure_step(s));
         } else {
-            self.peaks.feed(at, x.foot[2]);
+            self.peaks.feed(at, x.foot.up());
         }
     }
 

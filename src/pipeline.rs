@@ -36,9 +36,10 @@ use crate::phase_stats::StrideStats;
 use crate::phases::PhaseMethod;
 use crate::rate::SampleRate;
 use crate::rest::{RestDetector, RestThresholds};
-use crate::sample::{AccelRange, GyroRange, RawSample};
+use crate::sample::RawSample;
 use crate::stance::StanceLimits;
 use crate::stride::{Origin, Stride, MAX_MOVEMENT_SAMPLES, MIN_MOVEMENT_MS};
+use crate::units::{AccelScale, GyroScale};
 
 /// Capacity of the mean filter; the window used is the power of two nearest
 /// [`MEAN_FILTER_MS`] at the sample rate, at most this.
@@ -74,10 +75,11 @@ pub const DEFAULT_MODEL: Model = crate::trained::LODO_BEST;
 pub struct Config {
     /// Sample rate.
     pub rate: SampleRate,
-    /// Accelerometer range the counts are in.
-    pub accel: AccelRange,
-    /// Gyroscope range the counts are in.
-    pub gyro: GyroRange,
+    /// Accelerometer scale of the counts (counts per g; the MPU6050's from
+    /// [`crate::sample::AccelRange::scale`]).
+    pub accel: AccelScale,
+    /// Gyroscope scale of the counts (counts per °/s; [`crate::sample::GyroRange::scale`]).
+    pub gyro: GyroScale,
     /// Step detector.
     pub detector: Detector,
     /// Phase splitter version.
@@ -100,10 +102,10 @@ pub struct Config {
 }
 
 impl Config {
-    /// The default configuration for data at `rate` in the given ranges: the stance
+    /// The default configuration for data at `rate` in the given scales: the cycle
     /// detector, the augmented phase splitter, the [`DEFAULT_MODEL`] with the shipped
     /// [`crate::trained::PARAMS`], and the default height.
-    pub const fn new(rate: SampleRate, accel: AccelRange, gyro: GyroRange) -> Self {
+    pub const fn new(rate: SampleRate, accel: AccelScale, gyro: GyroScale) -> Self {
         Config {
             rate,
             accel,
@@ -119,8 +121,8 @@ impl Config {
         }
     }
 
-    /// The model behind the strides' lengths: [`Config::model`] for the stance detector,
-    /// Lu's fuzzy Weinberg (his whole chain) for the peak-valley detector.
+    /// The model behind the strides' lengths: [`Config::model`], unless the detector measures
+    /// with its own chain (Lu's fuzzy Weinberg for the peak-valley detector).
     pub const fn length_model(&self) -> Model {
         self.detector.length_model(self.model)
     }

@@ -12,7 +12,7 @@
 //! converted to counts for the configured ranges; the window follows the sample rate.
 
 use crate::rate::SampleRate;
-use crate::sample::{AccelRange, GyroRange};
+use crate::units::{AccelScale, GyroScale};
 
 /// Window length in milliseconds (5 samples at 100 Hz, as SHOE uses).
 pub const WINDOW_MS: u32 = 50;
@@ -38,7 +38,7 @@ pub struct RestThresholds {
 
 impl RestThresholds {
     /// Thresholds for a sample rate and sensor ranges.
-    pub const fn new(rate: SampleRate, accel: AccelRange, gyro: GyroRange) -> Self {
+    pub const fn new(rate: SampleRate, accel: AccelScale, gyro: GyroScale) -> Self {
         let window = rate.samples_in_ms(WINDOW_MS);
         let window = if window < 3 {
             3

@@ -1,5 +1,7 @@
 //! One raw MPU6050 sample as it comes off the bus, and the sensor's full-scale ranges.
 
+use crate::units::{AccelScale, GyroScale};
+
 /// Accelerometer full-scale range (register `ACCEL_CONFIG.AFS_SEL`).
 ///
 /// The default is ±16 g: heel strikes of a foot-mounted sensor exceed 8 g.
@@ -17,6 +19,11 @@ pub enum AccelRange {
 }
 
 impl AccelRange {
+    /// The scale the stages compute in.
+    pub const fn scale(self) -> AccelScale {
+        AccelScale::from_lsb_per_g(self.lsb_per_g())
+    }
+
     /// Counts per g (datasheet sensitivity).
     pub const fn lsb_per_g(self) -> u32 {
         16384 >> self.afs_sel()
@@ -59,6 +66,11 @@ pub enum GyroRange {
 }
 
 impl GyroRange {
+    /// The scale the stages compute in.
+    pub const fn scale(self) -> GyroScale {
+        GyroScale::from_lsb_per_dps_x10(self.lsb_per_dps_x10())
+    }
+
     /// Counts per (°/s), times ten, so that every range is an integer (131.0 → 1310).
     pub const fn lsb_per_dps_x10(self) -> u32 {
         match self {
@@ -72,10 +84,7 @@ impl GyroRange {
     /// An angular rate in mrad/s as counts of this range, rounded (exact to ±0.5 count
     /// plus 1 ppm for π; any `mrad_per_s` up to 10⁶, 1 000 rad/s).
     pub const fn counts_of_mrad_per_s(self, mrad_per_s: u32) -> u32 {
-        // counts = mrad/1000 · (180/π) · lsb10/10, π as 3 141 593 / 10⁶.
-        let num = mrad_per_s as u64 * self.lsb_per_dps_x10() as u64 * 180 * 1_000_000;
-        let den = 3_141_593u64 * 10_000;
-        ((num + den / 2) / den) as u32
+        self.scale().counts_of_mrad_per_s(mrad_per_s)
     }
 
     /// The range for an `FS_SEL` field value; `None` above 3.

@@ -46,7 +46,7 @@
 
 use crate::foot_frame::FOOT_LSB_PER_G;
 use crate::rate::SampleRate;
-use crate::sample::GyroRange;
+use crate::units::{FootAccel, GyroScale};
 
 /// Half-widths of the three windows, ms (full windows 2·h + 1 samples: 30, 60, 120 ms).
 pub const HALF_WINDOW_MS: [u32; 3] = [15, 30, 60];
@@ -104,12 +104,12 @@ impl StanceLimits {
 
 impl StanceThresholds {
     /// The shipped thresholds for a sample rate and gyro range.
-    pub const fn new(rate: SampleRate, gyro: GyroRange) -> Self {
+    pub const fn new(rate: SampleRate, gyro: GyroScale) -> Self {
         Self::with_limits(rate, gyro, StanceLimits::DEFAULT)
     }
 
     /// `limits` for a sample rate and gyro range (the threshold sweep of the module doc).
-    pub const fn with_limits(rate: SampleRate, gyro: GyroRange, limits: StanceLimits) -> Self {
+    pub const fn with_limits(rate: SampleRate, gyro: GyroScale, limits: StanceLimits) -> Self {
         let mut half = [0u32; 3];
         let mut k = 0;
         while k < 3 {
@@ -242,13 +242,13 @@ impl StanceDetector {
     /// Pushes one sample: `foot` is the foot-frame acceleration `[forward, left, up − g]`
     /// in g/2048 and `gyro` the raw angular rate (counts). Returns `Some(stance)` about the
     /// sample [`StanceDetector::delay`] inputs back, `None` until the windows are full.
-    pub fn process(&mut self, foot: [i16; 3], gyro: [i16; 3]) -> Option<bool> {
+    pub fn process(&mut self, foot: FootAccel, gyro: [i16; 3]) -> Option<bool> {
         let n = self.n;
         let seen = self.seen;
         self.n = self.n.wrapping_add(1);
         self.seen = self.seen.saturating_add(1);
         let slot = |i: u32| i as usize & (RING_CAPACITY - 1);
-        self.ring[slot(n)] = [deflate(foot[2]), deflate(foot[0])];
+        self.ring[slot(n)] = [deflate(foot.up()), deflate(foot.forward())];
         self.gyro[slot(n)] = gyro
             .iter()
             .map(|&v| v.unsigned_abs() as u32 * v.unsigned_abs() as u32)
@@ -319,7 +319,10 @@ mod tests {
 
     fn detector() -> StanceDetector {
         let rate = SampleRate::from_hz(200).unwrap();
-        StanceDetector::new(StanceThresholds::new(rate, GyroRange::Dps2000))
+        StanceDetector::new(StanceThresholds::new(
+            rate,
+            crate::sample::GyroRange::Dps2000.scale(),
+        ))
     }
 
     /// Decisions about every centre for a signal given per input sample.
@@ -328,7 +331,7 @@ mod tests {
         let mut out = [None; 512];
         for i in 0..n {
             let (foot, gyro) = signal(i);
-            if let Some(still) = d.process(foot, gyro) {
+            if let Some(still) = d.process(FootAccel(foot), gyro) {
                 out[(i - d.delay()) as usize] = Some(still);
             }
         }
@@ -337,15 +340,18 @@ mod tests {
 
     #[test]
     fn windows_are_centred_and_the_answer_waits_for_the_largest() {
-        let t = StanceThresholds::new(SampleRate::from_hz(200).unwrap(), GyroRange::Dps2000);
+        let t = StanceThresholds::new(
+            SampleRate::from_hz(200).unwrap(),
+            crate::sample::GyroRange::Dps2000.scale(),
+        );
         assert_eq!(t.half, [3, 6, 12]);
         assert_eq!(t.delay(), 12);
         let mut d = detector();
         // No answer until the largest window (2·12 + 1) is full.
         for i in 0..24 {
-            assert_eq!(d.process([0; 3], [0; 3]), None, "input {i}");
+            assert_eq!(d.process(FootAccel([0; 3]), [0; 3]), None, "input {i}");
         }
-        assert_eq!(d.process([0; 3], [0; 3]), Some(true));
+        assert_eq!(d.process(FootAccel([0; 3]), [0; 3]), Some(true));
     }
 
     #[test]
@@ -393,13 +399,13 @@ mod tests {
     fn reset_forgets_the_history() {
         let mut d = detector();
         for _ in 0..50 {
-            d.process([0; 3], [5000, 0, 0]);
+            d.process(FootAccel([0; 3]), [5000, 0, 0]);
         }
         d.reset();
         for _ in 0..24 {
-            assert_eq!(d.process([0; 3], [0; 3]), None);
+            assert_eq!(d.process(FootAccel([0; 3]), [0; 3]), None);
         }
-        assert_eq!(d.process([0; 3], [0; 3]), Some(true));
+        assert_eq!(d.process(FootAccel([0; 3]), [0; 3]), Some(true));
     }
 
     #[test]

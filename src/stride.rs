@@ -46,8 +46,9 @@ use crate::phases::{self, PhaseMethod};
 use crate::pipeline::Config;
 use crate::rate::SampleRate;
 use crate::rest::RestSums;
-use crate::sample::{GyroRange, RawSample};
+use crate::sample::RawSample;
 use crate::stance::{StanceDetector, StanceThresholds};
+use crate::units::{FootAccel, GyroScale};
 use crate::zupt::ZuptIntegrator;
 
 /// Default capacity of the movement buffer: 1.024 s at 1 kHz, 5 s at 204.8 Hz, 10 s at
@@ -225,14 +226,14 @@ pub struct StrideTracker<const M: usize = MAX_MOVEMENT_SAMPLES> {
 impl StrideTracker {
     /// A tracker with the default movement buffer ([`MAX_MOVEMENT_SAMPLES`]) for a sample
     /// rate and gyro range, splitting phases with `phase_method`.
-    pub const fn new(rate: SampleRate, gyro: GyroRange, phase_method: PhaseMethod) -> Self {
+    pub const fn new(rate: SampleRate, gyro: GyroScale, phase_method: PhaseMethod) -> Self {
         Self::sized(rate, gyro, phase_method)
     }
 }
 
 impl<const M: usize> StrideTracker<M> {
     /// A tracker with a movement buffer of `M` samples.
-    pub const fn sized(rate: SampleRate, gyro: GyroRange, phase_method: PhaseMethod) -> Self {
+    pub const fn sized(rate: SampleRate, gyro: GyroScale, phase_method: PhaseMethod) -> Self {
         StrideTracker {
             state: State::Unprimed,
             min_movement: rate.samples_in_ms(MIN_MOVEMENT_MS),
@@ -372,7 +373,7 @@ impl<const M: usize> StrideTracker<M> {
         &mut self,
         index: u32,
         s: &RawSample,
-        foot: [i16; 3],
+        foot: FootAccel,
         stance: bool,
         origin: Origin,
     ) -> Option<Stride> {
@@ -390,7 +391,7 @@ impl<const M: usize> StrideTracker<M> {
         &mut self,
         index: u32,
         s: &RawSample,
-        foot: [i16; 3],
+        foot: FootAccel,
         stance: bool,
         origin: Origin,
         out: &mut Option<Stride>,
@@ -460,7 +461,7 @@ impl<const M: usize> StrideTracker<M> {
         &mut self,
         index: u32,
         s: &RawSample,
-        foot: [i16; 3],
+        foot: FootAccel,
         stance: bool,
         out: &mut Option<Stride>,
     ) {
@@ -535,11 +536,11 @@ impl<const M: usize> StrideTracker<M> {
         self.stance_sums.add(s);
     }
 
-    fn accumulate_movement(&mut self, s: &RawSample, foot: [i16; 3]) {
+    fn accumulate_movement(&mut self, s: &RawSample, foot: FootAccel) {
         self.zupt.process(s);
         if self
             .movement
-            .push([foot[2], foot[0], magnitude_minus_g(foot)])
+            .push([foot.up(), foot.forward(), magnitude_minus_g(foot)])
             .is_err()
         {
             self.flags |= StrideFlags::TOO_LONG;
@@ -611,9 +612,10 @@ impl<const M: usize> StrideTracker<M> {
 
 /// `|f| − g` of a foot-frame sample `[forward, left, up − g]` (g/2048), in g/2048,
 /// saturated to `i16`: the orientation-free magnitude channel of [`crate::phase_stats`].
-pub(crate) fn magnitude_minus_g(foot: [i16; 3]) -> i16 {
-    let up = foot[2] as i64 + FOOT_LSB_PER_G as i64;
-    let m2 = (foot[0] as i64).pow(2) + (foot[1] as i64).pow(2) + up * up;
+pub(crate) fn magnitude_minus_g(foot: FootAccel) -> i16 {
+    let [forward, left, up] = foot.0;
+    let up = up as i64 + FOOT_LSB_PER_G as i64;
+    let m2 = (forward as i64).pow(2) + (left as i64).pow(2) + up * up;
     let m = isqrt_u64(m2 as u64) as i64 - FOOT_LSB_PER_G as i64;
     m.clamp(i16::MIN as i64, i16::MAX as i64) as i16
 }
@@ -768,7 +770,11 @@ mod tests {
 
     fn tracker() -> StrideTracker<MAX_MOVEMENT_SAMPLES> {
         let rate = SampleRate::from_hz(RATE_HZ).unwrap();
-        StrideTracker::sized(rate, GyroRange::Dps2000, PhaseMethod::Augmented)
+        StrideTracker::sized(
+            rate,
+            crate::sample::GyroRange::Dps2000.scale(),
+            PhaseMethod::Augmented,
+        )
     }
 
     /// Feeds runs of `(stance, samples)` from sample `*next`; returns each stride with the
@@ -777,7 +783,7 @@ mod tests {
         let mut out = Vec::new();
         for &(stance, n) in runs {
             for _ in 0..n {
-                let foot = if stance { [0; 3] } else { [300, 0, 300] };
+                let foot = FootAccel(if stance { [0; 3] } else { [300, 0, 300] });
                 if let Some(s) = t.process(*next, &REST, foot, stance, Origin::Measured) {
                     out.push((*next, s)).unwrap();
                 }
@@ -915,14 +921,14 @@ mod tests {
     fn interpolated_samples_flag_the_stride_they_fall_in() {
         let (mut t, mut n) = (tracker(), 0);
         feed(&mut t, &mut n, &[(true, 100), (false, 30)]);
-        t.process(n, &REST, [300, 0, 300], false, Origin::Bridged);
+        t.process(n, &REST, FootAccel([300, 0, 300]), false, Origin::Bridged);
         n += 1;
         feed(&mut t, &mut n, &[(false, 29), (true, 10)]);
         let s = t.finish().unwrap();
         assert!(s.flags.has(StrideFlags::BRIDGED) && s.flags.valid());
         let (mut t, mut n) = (tracker(), 0);
         feed(&mut t, &mut n, &[(true, 100), (false, 30)]);
-        t.process(n, &REST, [300, 0, 300], false, Origin::Filled);
+        t.process(n, &REST, FootAccel([300, 0, 300]), false, Origin::Filled);
         n += 1;
         feed(&mut t, &mut n, &[(false, 29), (true, 10)]);
         let s = t.finish().unwrap();

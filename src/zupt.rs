@@ -16,7 +16,8 @@
 use crate::fixed::{div_round_i128, isqrt_u64, QuatQ30};
 use crate::rate::SampleRate;
 use crate::rest::RestSums;
-use crate::sample::{GyroRange, RawSample};
+use crate::sample::RawSample;
+use crate::units::GyroScale;
 
 /// π · 2³².
 const PI_Q32: u128 = 13_493_037_705;
@@ -35,7 +36,7 @@ pub struct RollingContact {
 impl RollingContact {
     /// For a sensor `height_um` above the contact, at `rate` with gyro range `gyro`.
     /// Range: heights up to 1 m, any supported rate.
-    pub const fn new(height_um: u32, rate: SampleRate, gyro: GyroRange) -> Self {
+    pub const fn new(height_um: u32, rate: SampleRate, gyro: GyroScale) -> Self {
         // v_q8 = ω_counts · (π/180)/lsb · h · gravity_q8 · rate / g, with ω·(π/180)/lsb in
         // rad/s: π·10·h_um·rate_mHz / (180·lsb10·1e6·1e3·9.80665) per (count · count·2⁸).
         let num = PI_Q32 * 10 * height_um as u128 * rate.millihertz() as u128;
@@ -110,7 +111,7 @@ pub struct ZuptIntegrator {
 
 impl ZuptIntegrator {
     /// An idle integrator for a sample rate and gyro range.
-    pub const fn new(rate: SampleRate, gyro: GyroRange) -> Self {
+    pub const fn new(rate: SampleRate, gyro: GyroScale) -> Self {
         // rad per count / (2 · rate) · 2⁴⁶ = π·10⁴·2⁴⁶ / (360 · lsb10 · rate_mHz).
         let num = PI_Q32 * (1 << 14) * 10_000;
         let den = 360 * gyro.lsb_per_dps_x10() as u128 * rate.millihertz() as u128;

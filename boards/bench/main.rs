@@ -55,8 +55,8 @@ const RATE: SampleRate = unwrap(SampleRate::from_millihertz(trace::RATE_MILLIHER
 const CONFIG: Config = {
     let mut c = Config::new(
         RATE,
-        unwrap(AccelRange::from_afs_sel(trace::ACCEL_AFS_SEL)),
-        unwrap(GyroRange::from_fs_sel(trace::GYRO_FS_SEL)),
+        unwrap(AccelRange::from_afs_sel(trace::ACCEL_AFS_SEL)).scale(),
+        unwrap(GyroRange::from_fs_sel(trace::GYRO_FS_SEL)).scale(),
     );
     c.detector = gaitclip_board::DETECTOR;
     c

@@ -539,8 +539,8 @@ pub fn report(inp: &Inputs) -> Result<String> {
     let env = [("GAITCLIP_BENCH_TRACE", module.as_os_str())];
     let config = gaitclip::pipeline::Config::new(
         trace.sample_rate().context("trace rate")?,
-        ranges.accel,
-        ranges.gyro,
+        ranges.accel.scale(),
+        ranges.gyro.scale(),
     );
     let host = crate::replay::core_strides(&counts, config);
     let host_mm: u64 = host.iter().map(|s| u64::from(s.length_mm)).sum();

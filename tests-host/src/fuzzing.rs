@@ -83,7 +83,7 @@ pub fn core_pipeline(data: &[u8]) {
     let Some(rate) = SampleRate::from_hz(100 + 4 * *rate_b as u32) else {
         return;
     };
-    let mut config = Config::new(rate, AccelRange::G16, GyroRange::Dps2000);
+    let mut config = Config::new(rate, AccelRange::G16.scale(), GyroRange::Dps2000.scale());
     // The high bit picks the detector, the rest the model.
     config.model = Model::ALL[(*model_b & 0x7F) as usize % Model::ALL.len()];
     if *model_b & 0x80 != 0 {

@@ -152,7 +152,7 @@ fn walk(dataset: &str, trial: &eval::Trial, t: &Trace, decimate: usize) -> Resul
     let mhz = prepared.rate.millihertz() / decimate as u32;
     let rate = gaitclip::rate::SampleRate::from_millihertz(mhz)
         .with_context(|| format!("{}: rate {mhz} mHz", trial.csv.display()))?;
-    let mut config = Config::new(rate, ranges.accel, ranges.gyro);
+    let mut config = Config::new(rate, ranges.accel.scale(), ranges.gyro.scale());
     config.bridge_max_ms = FILL_MAX_MS;
     let strides = replay::core_strides(&counts, config);
     let scaled: Vec<eval::Reference> = references

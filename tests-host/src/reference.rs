@@ -22,17 +22,13 @@ use gaitclip::{rest, stance};
 use nalgebra::{Matrix3, SymmetricEigen, Vector3};
 
 use crate::eval::Detected;
-use crate::trace::{Ranges, G_MPS2};
+use crate::trace::G_MPS2;
 
 /// Runs the reference over raw counts; strides in the order the core reports them.
 pub fn strides(samples: &[RawSample], config: Config) -> Vec<Detected> {
-    let ranges = Ranges {
-        accel: config.accel,
-        gyro: config.gyro,
-    };
     let (ka, kg) = (
-        ranges.accel_counts_per_mps2(),
-        ranges.gyro_counts_per_radps(),
+        config.accel.lsb_per_g() as f64 / G_MPS2,
+        config.gyro.lsb_per_dps_x10() as f64 / 10.0 * 180.0 / std::f64::consts::PI,
     );
     let acc: Vec<Vector3<f64>> = samples
         .iter()
@@ -65,8 +61,12 @@ impl Reference {
             // Power of two nearest n, at most 16.
             (2f64.powf(n.log2().round())).min(16.0) as usize
         };
-        let t = stance::StanceThresholds::new(rate, gaitclip::sample::GyroRange::Dps2000);
-        let r = rest::RestThresholds::new(rate, Default::default(), Default::default());
+        let t = stance::StanceThresholds::new(rate, gaitclip::sample::GyroRange::Dps2000.scale());
+        let r = rest::RestThresholds::new(
+            rate,
+            gaitclip::sample::AccelRange::default().scale(),
+            gaitclip::sample::GyroRange::default().scale(),
+        );
         Reference {
             filter_len,
             rest_window: r.window as usize,

@@ -223,7 +223,7 @@ pub fn replay_counts(
     ranges: Ranges,
     t_s: impl Fn(u32) -> f64,
 ) -> Vec<StrideReport> {
-    let config = Config::new(rate, ranges.accel, ranges.gyro);
+    let config = Config::new(rate, ranges.accel.scale(), ranges.gyro.scale());
     replay_counts_with(samples, config, t_s)
 }
 
@@ -337,7 +337,7 @@ impl Prepared {
 
     /// The default configuration at the core's rate and `ranges`.
     pub fn config(&self, ranges: Ranges) -> Config {
-        Config::new(self.rate, ranges.accel, ranges.gyro)
+        Config::new(self.rate, ranges.accel.scale(), ranges.gyro.scale())
     }
 }
 

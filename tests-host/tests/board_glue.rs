@@ -6,7 +6,7 @@ use embedded_hal_mock::eh1::delay::NoopDelay;
 use gaitclip::mpu6050::{Address, Config, Mpu6050, OutputRate};
 use gaitclip::pipeline::Pipeline;
 use gaitclip::rate::SampleRate;
-use gaitclip::sample::{GyroRange, RawSample};
+use gaitclip::sample::{AccelRange, GyroRange, RawSample};
 use gaitclip_board::{imu_sampler, replay_mpu6050, serial_line, startup};
 use imu_sampler::{BusRecovery, Counters, ImuSampler, Item, ReadMode};
 use replay_mpu6050::{ReplayBusError, ReplayMpu6050};
@@ -210,9 +210,10 @@ fn serial_stride_line_parses_back() {
 fn startup_nags_until_still_then_reports_bias_and_heading() {
     let counts = gaitclip_host::fixtures::firmware_trace_counts().unwrap();
     let rate = SampleRate::from_hz(200).unwrap();
-    let cfg = gaitclip::pipeline::Config::new(rate, Default::default(), GyroRange::Dps2000);
+    let cfg =
+        gaitclip::pipeline::Config::new(rate, AccelRange::G16.scale(), GyroRange::Dps2000.scale());
     let mut p = Pipeline::new(cfg);
-    let mut st = startup::Startup::new(rate, GyroRange::Dps2000);
+    let mut st = startup::Startup::new(rate, GyroRange::Dps2000.scale());
     let mut events = Vec::new();
     for s in &counts {
         p.process(s);

@@ -165,8 +165,8 @@ fn run(script: Script, pulses: usize) -> (Vec<Stride>, Vec<Item>, Counters) {
     let rate = SampleRate::from_hz(200).unwrap();
     let mut p = Pipeline::new(pipeline::Config::new(
         rate,
-        AccelRange::G16,
-        GyroRange::Dps2000,
+        AccelRange::G16.scale(),
+        GyroRange::Dps2000.scale(),
     ));
     let (mut items, mut strides) = (Vec::new(), Vec::new());
     for _ in 0..pulses {

@@ -149,8 +149,8 @@ fn bench_runs_to_the_end_on_m0_with_each_detector() {
 fn demo_config() -> Config {
     Config::new(
         gaitclip::rate::SampleRate::from_millihertz(200_000).expect("200 Hz"),
-        gaitclip::sample::AccelRange::G16,
-        gaitclip::sample::GyroRange::Dps2000,
+        gaitclip::sample::AccelRange::G16.scale(),
+        gaitclip::sample::GyroRange::Dps2000.scale(),
     )
 }
 

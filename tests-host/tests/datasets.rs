@@ -161,13 +161,19 @@ fn no_stride_is_lost_between_holes() {
         for detector in gaitclip::pipeline::Detector::ALL {
             let mut config = gaitclip::pipeline::Config::new(
                 prepared.rate,
-                Ranges::default().accel,
-                Ranges::default().gyro,
+                Ranges::default().accel.scale(),
+                Ranges::default().gyro.scale(),
             );
             config.detector = *detector;
             let got = prepared.strides(config);
             for (k, s) in got.iter().enumerate() {
-                assert_eq!(s.index as usize, k, "{} {}: stride {k}", f.display(), detector.name());
+                assert_eq!(
+                    s.index as usize,
+                    k,
+                    "{} {}: stride {k}",
+                    f.display(),
+                    detector.name()
+                );
             }
             strides += got.len();
         }

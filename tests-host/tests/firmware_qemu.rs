@@ -80,7 +80,11 @@ fn qemu_m0_bridges_holes_as_the_host_replay() {
         n += 1;
     }
     let ranges = Ranges::default();
-    let config = Config::new(SampleRate::from_hz(200).unwrap(), ranges.accel, ranges.gyro);
+    let config = Config::new(
+        SampleRate::from_hz(200).unwrap(),
+        ranges.accel.scale(),
+        ranges.gyro.scale(),
+    );
     // With the micro:bit's movement buffer (256 samples): the stride the restart breaks
     // runs into the stand after it, longer than that buffer holds (flagged too long there).
     let host_strides = {
@@ -207,7 +211,11 @@ fn strides_equal_host_replay(
 
     let counts = gaitclip_host::fixtures::firmware_trace_counts().unwrap();
     let ranges = Ranges::default();
-    let mut config = Config::new(SampleRate::from_hz(200).unwrap(), ranges.accel, ranges.gyro);
+    let mut config = Config::new(
+        SampleRate::from_hz(200).unwrap(),
+        ranges.accel.scale(),
+        ranges.gyro.scale(),
+    );
     config.detector = detector;
     let host: Vec<LoggedStride> = replay_counts_with(&counts, config, |i| i as f64)
         .iter()

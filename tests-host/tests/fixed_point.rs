@@ -209,7 +209,11 @@ fn rest_thresholds_match_physical_units_within_one_count() {
         (AccelRange::G16, GyroRange::Dps2000),
         (AccelRange::G2, GyroRange::Dps250),
     ] {
-        let t = RestThresholds::new(SampleRate::from_hz(200).unwrap(), accel, gyro);
+        let t = RestThresholds::new(
+            SampleRate::from_hz(200).unwrap(),
+            accel.scale(),
+            gyro.scale(),
+        );
         let a = ACCEL_STD_MAX_MMPS2 as f64 / 1000.0 * accel.lsb_per_g() as f64 / 9.80665;
         let g = GYRO_RMS_MAX_MRADPS as f64 / 1000.0 * 180.0 / std::f64::consts::PI
             * gyro.lsb_per_dps_x10() as f64
@@ -225,7 +229,7 @@ fn stance_thresholds_match_physical_units() {
     // Deflated units per (m/s²)²: 2048 · 8 / 9.80665².
     let per = 2048.0 * 8.0 / (9.80665 * 9.80665);
     for (hz, half) in [(100, [2, 3, 6]), (200, [3, 6, 12]), (1000, [15, 30, 60])] {
-        let t = StanceThresholds::new(SampleRate::from_hz(hz).unwrap(), GyroRange::Dps2000);
+        let t = StanceThresholds::new(SampleRate::from_hz(hz).unwrap(), GyroRange::Dps2000.scale());
         assert_eq!(t.half, half, "{hz} Hz");
         let std = DEFLATED_STD_MAX as f64 / 1000.0 * per;
         assert!(((t.variance as f64).sqrt() - std).abs() <= 1.0);
@@ -262,8 +266,8 @@ fn foot_frame_rotation_matches_f64_within_one_unit() {
             let up_sensor = [m[2][0] * lsb, m[2][1] * lsb, m[2][2] * lsb];
             let mut est = FootFrameEstimator::new(
                 SampleRate::from_hz(200).unwrap(),
-                range,
-                GyroRange::Dps2000,
+                range.scale(),
+                GyroRange::Dps2000.scale(),
             );
             let rest = RawSample {
                 accel: up_sensor.map(|v| v.round() as i16),
@@ -275,10 +279,10 @@ fn foot_frame_rotation_matches_f64_within_one_unit() {
             }
             est.process(&rest, false);
             let f = est.frame().expect("frame after a rest");
-            let axes = f.axes(range);
+            let axes = f.axes(range.scale());
             for _ in 0..500 {
                 let a = [0; 3].map(|_| r.random::<i16>());
-                let got = f.apply(a);
+                let got = f.apply(a).0;
                 for k in 0..3 {
                     let dot: f64 = (0..3).map(|j| axes[k][j] as f64 * a[j] as f64).sum();
                     let mut exact = dot * 2048.0 / lsb;
@@ -387,7 +391,7 @@ fn zupt_displacement_matches_f64_reference_within_1mm() {
         let (heel_off, end): (usize, usize) = (c[2].parse().unwrap(), c[5].parse().unwrap());
         let stance = &counts[heel_off - 20..heel_off];
         let movement = &counts[heel_off..end];
-        let mut z = ZuptIntegrator::new(rate, GyroRange::Dps2000);
+        let mut z = ZuptIntegrator::new(rate, GyroRange::Dps2000.scale());
         let mut sums = RestSums::new();
         stance.iter().for_each(|s| sums.add(s));
         assert_eq!(sums.count as usize, stance.len());
@@ -528,8 +532,14 @@ fn cycle_energy_matches_f64_within_its_bound() {
         (AccelRange::G2, GyroRange::Dps250),
         (AccelRange::G8, GyroRange::Dps500),
     ] {
-        let cfg = CycleConfig::new(rate, accel, gyro, PhaseMethod::MajorPairs, 80_000);
-        let config = Config::new(rate, accel, gyro);
+        let cfg = CycleConfig::new(
+            rate,
+            accel.scale(),
+            gyro.scale(),
+            PhaseMethod::MajorPairs,
+            80_000,
+        );
+        let config = Config::new(rate, accel.scale(), gyro.scale());
         let lsb_g = accel.lsb_per_g() as f64;
         let per_count2 = (9.80665 / lsb_g).powi(2) * 65536.0;
         let mut worst = 0f64;
@@ -577,7 +587,7 @@ fn rolling_contact_velocity_matches_f64() {
     ] {
         let rate = SampleRate::from_hz(hz).unwrap();
         for h_um in [0u32, 40_000, 80_000, 120_000] {
-            let rc = RollingContact::new(h_um, rate, gyro);
+            let rc = RollingContact::new(h_um, rate, gyro.scale());
             for _ in 0..2_000 {
                 let q = random_unit(&mut r);
                 let w = [0; 3].map(|_| r.random_range(-20_000i32..20_000));

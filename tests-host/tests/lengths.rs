@@ -320,7 +320,7 @@ fn the_zupt_shortcut_gives_the_full_features_length() {
     let counts = gaitclip_host::fixtures::firmware_trace_counts().unwrap();
     let rate = gaitclip::rate::SampleRate::from_hz(200).unwrap();
     let ranges = gaitclip_host::trace::Ranges::default();
-    let config = gaitclip::pipeline::Config::new(rate, ranges.accel, ranges.gyro);
+    let config = gaitclip::pipeline::Config::new(rate, ranges.accel.scale(), ranges.gyro.scale());
     let (strides, _) = gaitclip_host::replay::core_run_with_stats(&counts, &[], config);
     assert!(strides.len() >= 20);
     let p = &gaitclip::trained::PARAMS;

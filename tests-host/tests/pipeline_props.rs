@@ -52,8 +52,11 @@ fn check<const M: usize>(
     gaps: &[(usize, u32)],
 ) -> Vec<Stride> {
     let rate = SampleRate::from_hz(rate_hz).unwrap();
-    let mut p =
-        Pipeline::<AnyDetector<M>>::sized(Config::new(rate, AccelRange::G16, GyroRange::Dps2000));
+    let mut p = Pipeline::<AnyDetector<M>>::sized(Config::new(
+        rate,
+        AccelRange::G16.scale(),
+        GyroRange::Dps2000.scale(),
+    ));
     let mut strides = Vec::new();
     for (i, s) in samples.iter().enumerate() {
         for &(_, missing) in gaps.iter().filter(|g| g.0 == i) {

@@ -15,7 +15,7 @@ use gaitclip_host::{csv_trace, reference, replay};
 fn compare(name: &str, trace: &Trace, method: PhaseMethod) -> Vec<u32> {
     let ranges = Ranges::default();
     let rate = trace.sample_rate().expect("rate in range");
-    let mut config = Config::new(rate, ranges.accel, ranges.gyro);
+    let mut config = Config::new(rate, ranges.accel.scale(), ranges.gyro.scale());
     config.detector = Detector::Stance;
     config.phases = method;
     let counts: Vec<_> = trace.samples.iter().map(|s| ranges.to_counts(s)).collect();

@@ -32,7 +32,7 @@ pub const STATUS_EVERY_MS: u32 = 60_000;
 /// The pipeline's configuration for samples at `rate` in the given ranges, with the
 /// firmware's [`crate::DETECTOR`].
 pub const fn config(rate: SampleRate, accel: AccelRange, gyro: GyroRange) -> Config {
-    let mut c = Config::new(rate, accel, gyro);
+    let mut c = Config::new(rate, accel.scale(), gyro.scale());
     c.detector = crate::DETECTOR;
     c
 }

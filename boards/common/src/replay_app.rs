@@ -132,7 +132,7 @@ pub fn run<D: StepDetector, T: SampleTimer>(
     // unmasking cannot break a critical section.
     unsafe { cortex_m::peripheral::NVIC::unmask(Irq(T::IRQ)) };
 
-    let mut startup = Startup::new(RATE, GYRO);
+    let mut startup = Startup::new(RATE, GYRO.scale());
     let mut samples = 0u32;
     loop {
         while let Some(item) = consumer.dequeue() {

@@ -16,7 +16,7 @@
 use gaitclip::detector::StepDetector;
 use gaitclip::pipeline::Pipeline;
 use gaitclip::rate::SampleRate;
-use gaitclip::sample::GyroRange;
+use gaitclip::units::GyroScale;
 
 /// How often to repeat the "hold still" message.
 pub const NAG_EVERY_MS: u32 = 2000;
@@ -56,14 +56,14 @@ enum Stage {
 /// Follows the core's calibration and says what changed.
 pub struct Startup {
     rate: SampleRate,
-    gyro: GyroRange,
+    gyro: GyroScale,
     stage: Stage,
     next_nag: u32,
 }
 
 impl Startup {
     /// Progress reporting for samples at `rate` in the gyro range `gyro`.
-    pub const fn new(rate: SampleRate, gyro: GyroRange) -> Self {
+    pub const fn new(rate: SampleRate, gyro: GyroScale) -> Self {
         Startup {
             rate,
             gyro,
