@@ -1,6 +1,13 @@
-//! Locating `../shared/datasets` (third-party recordings, never copied into the repository).
+//! The datasets of `../shared/datasets` (third-party recordings, never copied into the
+//! repository): locating them, and loading each one's trials and reference strides.
 
-use std::path::PathBuf;
+use std::collections::BTreeMap;
+use std::path::{Path, PathBuf};
+
+use anyhow::{bail, Context, Result};
+use serde::Deserialize;
+
+use crate::clock::SampleClock;
 
 /// The datasets folder beside the repository, if present.
 pub fn root() -> Option<PathBuf> {
@@ -37,4 +44,299 @@ pub fn shared_or_skip(name: &str, test: &str) -> Option<PathBuf> {
             None
         }
     }
+}
+
+/// Times of a reference's events, s, where the dataset gives them (they override the
+/// rows when mapped to sample numbers).
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct ReferenceTimes {
+    /// Start of the interval holding the stride's movement.
+    pub start_s: Option<f64>,
+    /// Its end.
+    pub end_s: Option<f64>,
+    /// Toe-off.
+    pub toe_off_s: Option<f64>,
+    /// Heel-strike ending the swing.
+    pub heel_strike_s: Option<f64>,
+    /// Heel-strike that began the stride's ground contact.
+    pub prev_heel_strike_s: Option<f64>,
+}
+
+/// One reference stride (rows of the trial's CSV; [`Reference::in_numbers`] maps them to the
+/// sensor clock's sample numbers).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Reference {
+    /// Interval that contains the stride's movement.
+    pub start: u32,
+    /// End of that interval.
+    pub end: u32,
+    /// Not clean straight walking: neither counted nor missed.
+    pub flagged: bool,
+    /// Toe-off, where labelled.
+    pub toe_off: Option<u32>,
+    /// Heel-strike ending the swing, where labelled.
+    pub heel_strike: Option<u32>,
+    /// Heel-strike that began the stride's ground contact, where labelled.
+    pub prev_heel_strike: Option<u32>,
+    /// Reference stride length, m, where the dataset has one.
+    pub length_m: Option<f64>,
+    /// Event times, where the dataset gives them.
+    pub times: ReferenceTimes,
+}
+
+impl Reference {
+    /// The reference in sample numbers of `clock`: events given as times go to the nearest
+    /// number, the others from their rows.
+    pub fn in_numbers(&self, clock: &SampleClock) -> Reference {
+        let row = |r: u32| clock.number_of_row(r as usize);
+        let event = |t: Option<f64>, r: Option<u32>| match t {
+            Some(t) => Some(clock.number_at(t)),
+            None => r.map(row),
+        };
+        Reference {
+            start: event(self.times.start_s, Some(self.start)).unwrap_or(0),
+            end: event(self.times.end_s, Some(self.end)).unwrap_or(0),
+            toe_off: event(self.times.toe_off_s, self.toe_off),
+            heel_strike: event(self.times.heel_strike_s, self.heel_strike),
+            prev_heel_strike: event(self.times.prev_heel_strike_s, self.prev_heel_strike),
+            ..*self
+        }
+    }
+}
+
+/// One recording and its ground truth.
+#[derive(Clone, Debug)]
+pub struct Trial {
+    /// Name as the dataset gives it.
+    pub name: String,
+    /// The trial's CSV.
+    pub csv: PathBuf,
+    /// Reference strides.
+    pub references: Vec<Reference>,
+    /// Labelled part of the recording, rows `[from, to)`.
+    pub span: (u32, u32),
+    /// The same bounds as times, s, where the dataset gives them (they override the rows).
+    pub span_s: Option<(f64, f64)>,
+    /// A part of the span whose steps are not labelled one by one, s (`ipol_gait_events`'
+    /// U-turn): detections lying mostly inside it are not scored.
+    pub unscored_s: Option<(f64, f64)>,
+    /// Per-sample stance label, where the dataset has one.
+    pub stance: Option<Vec<bool>>,
+    /// The walker's height, m, where the dataset gives it.
+    pub height_m: Option<f64>,
+    /// Distance walked over `span`, m, where the dataset gives it (not per stride).
+    pub distance_m: Option<f64>,
+}
+
+/// A dataset folder.
+#[derive(Clone, Debug)]
+pub struct Dataset {
+    /// Folder name (`gaitmap_walk`, …).
+    pub name: String,
+    /// Nominal sample rate, Hz.
+    pub rate_hz: f64,
+    /// Its trials.
+    pub trials: Vec<Trial>,
+}
+
+#[derive(Deserialize)]
+struct Meta {
+    name: String,
+    sample_rate_hz: f64,
+}
+
+fn read_rows(path: &Path) -> Result<Vec<BTreeMap<String, String>>> {
+    let mut r = csv::Reader::from_path(path).with_context(|| format!("{}", path.display()))?;
+    let mut out = Vec::new();
+    for row in r.deserialize() {
+        out.push(row.with_context(|| format!("{}", path.display()))?);
+    }
+    Ok(out)
+}
+
+fn field<'a>(row: &'a BTreeMap<String, String>, k: &str, path: &Path) -> Result<&'a str> {
+    row.get(k)
+        .map(String::as_str)
+        .with_context(|| format!("{}: no column `{k}`", path.display()))
+}
+
+fn index(row: &BTreeMap<String, String>, k: &str, path: &Path) -> Result<u32> {
+    let v = field(row, k, path)?;
+    v.trim()
+        .parse()
+        .with_context(|| format!("{}: `{k}` = {v:?} is not an index", path.display()))
+}
+
+/// Loads a dataset folder of `../shared/datasets` (its layout is described there).
+pub fn load(dir: &Path) -> Result<Dataset> {
+    let meta_path = dir.join("meta.json");
+    let meta: Meta = serde_json::from_slice(
+        &std::fs::read(&meta_path).with_context(|| format!("{}", meta_path.display()))?,
+    )
+    .with_context(|| format!("{}", meta_path.display()))?;
+    let trials = match meta.name.as_str() {
+        "gaitmap_walk" | "pyshoe_vicon" => load_strides(dir, &meta.name)?,
+        "ipol_gait_events" => load_ipol(dir)?,
+        other => bail!("{}: unknown dataset {other:?}", dir.display()),
+    };
+    Ok(Dataset {
+        name: meta.name,
+        rate_hz: meta.sample_rate_hz,
+        trials,
+    })
+}
+
+fn load_strides(dir: &Path, name: &str) -> Result<Vec<Trial>> {
+    let path = dir.join("strides.csv");
+    let mut by_trial: BTreeMap<String, Vec<Reference>> = BTreeMap::new();
+    for row in read_rows(&path)? {
+        let opt = |k: &str| -> Result<Option<u32>> {
+            match row.get(k) {
+                Some(_) => index(&row, k, &path).map(Some),
+                None => Ok(None),
+            }
+        };
+        let r = Reference {
+            start: index(&row, "start_idx", &path)?,
+            end: index(&row, "end_idx", &path)?,
+            flagged: !field(&row, "flag", &path)?.trim().is_empty(),
+            toe_off: opt("tc_idx")?,
+            heel_strike: opt("ic_idx")?,
+            prev_heel_strike: opt("pre_ic_idx")?,
+            length_m: Some(
+                field(&row, "length_m", &path)?
+                    .trim()
+                    .parse()
+                    .with_context(|| format!("{}: length_m is not a number", path.display()))?,
+            ),
+            times: ReferenceTimes::default(),
+        };
+        by_trial
+            .entry(field(&row, "trial", &path)?.to_string())
+            .or_default()
+            .push(r);
+    }
+    let mut trials = Vec::new();
+    for (trial, references) in by_trial {
+        let span = (
+            references.iter().map(|r| r.start).min().unwrap_or(0),
+            references.iter().map(|r| r.end).max().unwrap_or(0),
+        );
+        let stance = if name == "pyshoe_vicon" {
+            let p = dir.join(format!("{trial}.reference.csv"));
+            let mut v = Vec::new();
+            for row in read_rows(&p)? {
+                v.push(field(&row, "stance_vicon", &p)?.trim() == "1");
+            }
+            Some(v)
+        } else {
+            None
+        };
+        trials.push(Trial {
+            csv: dir.join(format!("{trial}.csv")),
+            name: trial,
+            references,
+            span,
+            span_s: None,
+            stance,
+            unscored_s: None,
+            height_m: None,
+            distance_m: None,
+        });
+    }
+    Ok(trials)
+}
+
+fn load_ipol(dir: &Path) -> Result<Vec<Trial>> {
+    let tpath = dir.join("trials.csv");
+    let mut spans = BTreeMap::new();
+    let number = |row: &BTreeMap<String, String>, k: &str| -> Result<f64> {
+        let v = field(row, k, &tpath)?;
+        v.trim()
+            .parse()
+            .with_context(|| format!("{}: `{k}` = {v:?} is not a number", tpath.display()))
+    };
+    for row in read_rows(&tpath)? {
+        spans.insert(
+            field(&row, "trial", &tpath)?.to_string(),
+            (
+                (
+                    index(&row, "walk_start_idx", &tpath)?,
+                    index(&row, "walk_end_idx", &tpath)?,
+                ),
+                (number(&row, "walk_start_s")?, number(&row, "walk_end_s")?),
+                (number(&row, "uturn_start_s")?, number(&row, "uturn_end_s")?),
+                // Some subjects' heights are not given: left empty.
+                match field(&row, "height_m", &tpath)?.trim() {
+                    "" => None,
+                    _ => Some(number(&row, "height_m")?),
+                },
+                number(&row, "distance_m")?,
+            ),
+        );
+    }
+    let epath = dir.join("events.csv");
+    let mut by_trial: BTreeMap<(String, String), Vec<(u32, Reference)>> = BTreeMap::new();
+    let seconds = |row: &BTreeMap<String, String>, k: &str| -> Result<f64> {
+        let v = field(row, k, &epath)?;
+        v.trim()
+            .parse()
+            .with_context(|| format!("{}: `{k}` = {v:?} is not a number", epath.display()))
+    };
+    for row in read_rows(&epath)? {
+        let to = index(&row, "toe_off_idx", &epath)?;
+        let hs = index(&row, "heel_strike_idx", &epath)?;
+        let r = Reference {
+            start: to,
+            end: hs,
+            flagged: field(&row, "in_uturn", &epath)?.trim() == "True",
+            toe_off: Some(to),
+            heel_strike: Some(hs),
+            prev_heel_strike: None,
+            length_m: None,
+            times: {
+                let (to_s, hs_s) = (seconds(&row, "toe_off_s")?, seconds(&row, "heel_strike_s")?);
+                ReferenceTimes {
+                    start_s: Some(to_s),
+                    end_s: Some(hs_s),
+                    toe_off_s: Some(to_s),
+                    heel_strike_s: Some(hs_s),
+                    prev_heel_strike_s: None,
+                }
+            },
+        };
+        let key = (
+            field(&row, "trial", &epath)?.to_string(),
+            field(&row, "foot", &epath)?.to_string(),
+        );
+        by_trial
+            .entry(key)
+            .or_default()
+            .push((index(&row, "step", &epath)?, r));
+    }
+    let mut trials = Vec::new();
+    for ((trial, foot), mut steps) in by_trial {
+        steps.sort_by_key(|s| s.0);
+        let mut references: Vec<Reference> = steps.into_iter().map(|s| s.1).collect();
+        for k in 1..references.len() {
+            references[k].prev_heel_strike = references[k - 1].heel_strike;
+            references[k].times.prev_heel_strike_s = references[k - 1].times.heel_strike_s;
+        }
+        let (span, span_s, uturn_s, height, distance) = *spans
+            .get(&trial)
+            .with_context(|| format!("{}: no trial {trial}", tpath.display()))?;
+        trials.push(Trial {
+            csv: dir.join(format!("{trial}_{foot}.csv")),
+            name: format!("{trial}_{foot}"),
+            references,
+            // The rows are the left foot's: the right foot's file has its own holes.
+            span,
+            span_s: Some(span_s),
+            unscored_s: Some(uturn_s),
+            stance: None,
+            height_m: height,
+            distance_m: Some(distance),
+        });
+    }
+    Ok(trials)
 }

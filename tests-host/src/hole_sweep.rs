@@ -34,7 +34,8 @@ use gaitclip::sample::RawSample;
 use gaitclip::stride::{Stride, StrideFlags};
 
 use crate::clock::Gap;
-use crate::eval::{self, Detected};
+use crate::datasets;
+use crate::matching::{self, Detected};
 use crate::trace::{Ranges, Trace};
 use crate::{csv_trace, replay};
 
@@ -128,7 +129,7 @@ pub struct Walk {
 pub fn walks(root: &Path, decimate: usize) -> Result<Vec<Walk>> {
     let mut out = Vec::new();
     for name in DATASETS {
-        let d = eval::load(&root.join(name))?;
+        let d = datasets::load(&root.join(name))?;
         for trial in &d.trials {
             let t = csv_trace::read(&trial.csv, Some(d.rate_hz))?;
             out.push(walk(&d.name, trial, &t, decimate)?);
@@ -137,7 +138,7 @@ pub fn walks(root: &Path, decimate: usize) -> Result<Vec<Walk>> {
     Ok(out)
 }
 
-fn walk(dataset: &str, trial: &eval::Trial, t: &Trace, decimate: usize) -> Result<Walk> {
+fn walk(dataset: &str, trial: &datasets::Trial, t: &Trace, decimate: usize) -> Result<Walk> {
     let ranges = Ranges::default();
     let prepared =
         replay::prepare(t, ranges).with_context(|| format!("{}", trial.csv.display()))?;
@@ -155,9 +156,9 @@ fn walk(dataset: &str, trial: &eval::Trial, t: &Trace, decimate: usize) -> Resul
     let mut config = Config::new(rate, ranges.accel.scale(), ranges.gyro.scale());
     config.bridge_max_ms = FILL_MAX_MS;
     let strides = replay::core_strides(&counts, config);
-    let scaled: Vec<eval::Reference> = references
+    let scaled: Vec<datasets::Reference> = references
         .iter()
-        .map(|r| eval::Reference {
+        .map(|r| datasets::Reference {
             start: r.start / decimate as u32,
             end: r.end / decimate as u32,
             ..*r
@@ -166,7 +167,7 @@ fn walk(dataset: &str, trial: &eval::Trial, t: &Trace, decimate: usize) -> Resul
     let det: Vec<Detected> = strides.iter().map(Detected::from).collect();
     let period_ms = 1e6 / mhz as f64;
     let mut walking = Vec::new();
-    for (i, j) in eval::match_strides(&det, &scaled) {
+    for (i, j) in matching::match_strides(&det, &scaled) {
         let (s, r) = (&strides[i], &scaled[j]);
         let informational = StrideFlags::FROM_REST | StrideFlags::TO_REST | StrideFlags::TURN;
         let Some(len) = r.length_m else { continue };

@@ -17,7 +17,7 @@
 //!
 //! Per model and dataset: RMSE, MAE and bias (predicted − reference) over matched clean
 //! strides (reference unflagged, stride valid, and no second movement inside the
-//! reference's borders: see [`crate::eval::Scored::Unbordered`]), the same by stride speed
+//! reference's borders: see [`crate::matching::Scored::Unbordered`]), the same by stride speed
 //! (reference length over reference duration) and by stride length, and the walked-distance
 //! error per trial, `|Σ predicted − Σ reference| / Σ reference` over all the core's strides
 //! in the trial's span where the trial's walked distance is known (`gaitmap_walk`: its

@@ -15,6 +15,7 @@ pub mod hole_sweep;
 
 pub mod length_eval;
 pub mod length_ref;
+pub mod matching;
 pub mod mcap_io;
 pub mod peak_valley_ref;
 pub mod qemu;
@@ -22,6 +23,7 @@ pub mod reference;
 pub mod replay;
 pub mod sim;
 pub mod stats;
+pub mod tables;
 pub mod trace;
 pub mod train;
 pub mod zupt_sweep;

@@ -21,7 +21,7 @@ use gaitclip::stride::{MAX_MOVEMENT_SAMPLES, MAX_STANCE_IN_STRIDE_MS, MIN_MOVEME
 use gaitclip::{rest, stance};
 use nalgebra::{Matrix3, SymmetricEigen, Vector3};
 
-use crate::eval::Detected;
+use crate::matching::Detected;
 use crate::trace::G_MPS2;
 
 /// Runs the reference over raw counts; strides in the order the core reports them.

@@ -33,7 +33,8 @@ use ndarray::{Array1, Array2};
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 
-use crate::eval::{self, Dataset, Detected};
+use crate::datasets::{self, Dataset};
+use crate::matching::{self, Detected};
 use crate::trace::Ranges;
 use crate::{csv_trace, replay};
 use crate::{length_eval, length_ref};
@@ -106,12 +107,12 @@ pub fn run_dataset(dataset: &Dataset) -> Result<Vec<TrialRun>> {
             })
             .unzip();
         let det: Vec<Detected> = strides.iter().map(Detected::from).collect();
-        let scored = eval::classify(trial, &prepared.clock, &det, &references);
+        let scored = matching::classify(trial, &prepared.clock, &det, &references);
         // A reference that holds a movement its borders leave out measured two movements:
         // no length to compare one stride with.
-        let holds_two = |r: &eval::Reference| {
+        let holds_two = |r: &datasets::Reference| {
             det.iter().zip(&scored).any(|(d, c)| {
-                *c == eval::Scored::Unbordered
+                *c == matching::Scored::Unbordered
                     && 2 * (d.foot_flat.min(r.end)).saturating_sub(d.heel_off.max(r.start))
                         >= d.foot_flat - d.heel_off
             })
@@ -119,7 +120,7 @@ pub fn run_dataset(dataset: &Dataset) -> Result<Vec<TrialRun>> {
         let mut reference = vec![None; strides.len()];
         let mut speed_mps = vec![None; strides.len()];
         for (i, c) in scored.iter().enumerate() {
-            if let eval::Scored::Found(j) = *c {
+            if let matching::Scored::Found(j) = *c {
                 let r = &references[j];
                 if strides[i].flags.valid() && !holds_two(r) {
                     reference[i] = r.length_m;
@@ -735,7 +736,7 @@ pub fn choose_hyper(samples: &[Sample]) -> Result<(HyperSet, [f64; 4])> {
 pub fn load_training(shared_datasets: &Path) -> Result<Vec<TrialRun>> {
     let mut runs = Vec::new();
     for name in TRAINING_DATASETS {
-        runs.extend(run_dataset(&eval::load(&shared_datasets.join(name))?)?);
+        runs.extend(run_dataset(&datasets::load(&shared_datasets.join(name))?)?);
     }
     Ok(runs)
 }

@@ -23,8 +23,9 @@ use gaitclip::models::Model;
 use gaitclip::sample::{AccelRange, GyroRange};
 use gaitclip::stride::StrideFlags;
 
-use crate::eval::{self, Detected, Scored};
+use crate::datasets;
 use crate::length_eval::SPEED_BINS;
+use crate::matching::{self, Detected, Scored};
 use crate::trace::Ranges;
 use crate::{csv_trace, replay};
 
@@ -35,7 +36,11 @@ pub const HEIGHTS_MM: [u32; 6] = [0, 40, 60, 80, 100, 120];
 type Scoredstride = (f64, f64, bool);
 
 /// The ZUPT errors of one dataset at one height and range.
-fn errors(dataset: &eval::Dataset, ranges: Ranges, height_um: u32) -> Result<Vec<Scoredstride>> {
+fn errors(
+    dataset: &datasets::Dataset,
+    ranges: Ranges,
+    height_um: u32,
+) -> Result<Vec<Scoredstride>> {
     let mut out = Vec::new();
     for trial in &dataset.trials {
         let t = csv_trace::read(&trial.csv, Some(dataset.rate_hz))?;
@@ -47,10 +52,10 @@ fn errors(dataset: &eval::Dataset, ranges: Ranges, height_um: u32) -> Result<Vec
         let det: Vec<Detected> = strides.iter().map(Detected::from).collect();
         let refs = trial.references_in_numbers(&p.clock);
         let rate = p.clock.rate_hz();
-        let scored = eval::classify(trial, &p.clock, &det, &refs);
+        let scored = matching::classify(trial, &p.clock, &det, &refs);
         // As training scores: a reference holding a movement its borders leave out measured
         // two movements, and no stride is compared with it.
-        let holds_two = |r: &eval::Reference| {
+        let holds_two = |r: &datasets::Reference| {
             det.iter().zip(&scored).any(|(d, c)| {
                 *c == Scored::Unbordered
                     && 2 * (d.foot_flat.min(r.end)).saturating_sub(d.heel_off.max(r.start))
@@ -89,9 +94,9 @@ fn cell(e: &[f64]) -> String {
 /// The two tables, Markdown.
 pub fn report(root: &Path) -> Result<String> {
     let mut s = String::new();
-    let sets: Vec<eval::Dataset> = ["gaitmap_walk", "pyshoe_vicon"]
+    let sets: Vec<datasets::Dataset> = ["gaitmap_walk", "pyshoe_vicon"]
         .iter()
-        .map(|n| eval::load(&root.join(n)))
+        .map(|n| datasets::load(&root.join(n)))
         .collect::<Result<_>>()?;
     let bin_name = |(lo, hi): (f64, f64)| {
         if hi.is_infinite() {

@@ -7,7 +7,7 @@ use gaitclip::sample::{AccelRange, GyroRange};
 use gaitclip_host::cycle_ref::{self, Skipped};
 use gaitclip_host::datasets::root_or_skip;
 use gaitclip_host::trace::Ranges;
-use gaitclip_host::{csv_trace, eval, replay};
+use gaitclip_host::{csv_trace, datasets, replay};
 
 #[test]
 fn cycle_strides_match_the_f64_twin_within_1_mm() {
@@ -26,7 +26,7 @@ fn cycle_strides_match_the_f64_twin_within_1_mm() {
         ("gaitmap_walk", clipping),
         ("pyshoe_vicon", clipping),
     ] {
-        let d = eval::load(&root.join(name)).unwrap();
+        let d = datasets::load(&root.join(name)).unwrap();
         let (mut measured, mut valid, mut worst, mut clipped) = (0usize, 0usize, 0f64, 0usize);
         let mut skipped = [0usize; 4];
         for trial in &d.trials {

@@ -93,7 +93,8 @@ fn gaitmap_walk_strides_and_lengths() {
 /// that a regression fails here.
 #[test]
 fn eval_figures_on_recordings() {
-    use gaitclip_host::eval::{self, abs_quantile};
+    use gaitclip_host::stats::abs_quantile;
+    use gaitclip_host::{datasets, eval};
     let Some(root) = gaitclip_host::datasets::root_or_skip("eval_figures_on_recordings") else {
         return;
     };
@@ -104,7 +105,7 @@ fn eval_figures_on_recordings() {
         ("pyshoe_vicon", 0.99, f64::NAN, f64::NAN, f64::NAN),
         ("ipol_gait_events", 0.98, 45.0, 35.0, 0.82),
     ] {
-        let d = eval::load(&root.join(name)).unwrap();
+        let d = datasets::load(&root.join(name)).unwrap();
         let r = eval::evaluate(&d, &detector, 0, 1).unwrap();
         let t = &r.tally;
         let (m_to, m_hs) = (

@@ -6,7 +6,7 @@ use std::path::Path;
 use gaitclip::phases::PhaseMethod;
 use gaitclip::pipeline::{Config, Detector};
 use gaitclip_host::datasets;
-use gaitclip_host::eval::Detected;
+use gaitclip_host::matching::Detected;
 use gaitclip_host::trace::{Ranges, Trace};
 use gaitclip_host::{csv_trace, reference, replay};
 

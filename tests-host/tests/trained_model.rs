@@ -12,7 +12,7 @@ use gaitclip::features::Features;
 use gaitclip::models::{self, Model};
 use gaitclip::pipeline::DEFAULT_MODEL;
 use gaitclip_host::datasets::root_or_skip;
-use gaitclip_host::{eval, train};
+use gaitclip_host::{datasets, train};
 
 #[test]
 fn shipped_models_are_current_exact_and_meet_targets() {
@@ -21,7 +21,7 @@ fn shipped_models_are_current_exact_and_meet_targets() {
     };
     let mut runs = Vec::new();
     for name in ["gaitmap_walk", "pyshoe_vicon", "ipol_gait_events"] {
-        runs.extend(train::run_dataset(&eval::load(&root.join(name)).unwrap()).unwrap());
+        runs.extend(train::run_dataset(&datasets::load(&root.join(name)).unwrap()).unwrap());
     }
 
     // 1. Not stale.

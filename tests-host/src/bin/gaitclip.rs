@@ -9,7 +9,9 @@ use gaitclip::phases::PhaseMethod;
 use gaitclip::pipeline::{Config, Detector};
 use gaitclip_host::eval;
 use gaitclip_host::trace::{Ranges, Trace};
-use gaitclip_host::{csv_trace, fixtures, length_eval, mcap_io, replay, train};
+use gaitclip_host::{
+    csv_trace, datasets, fixtures, length_eval, matching, mcap_io, replay, tables, train,
+};
 
 #[derive(Parser)]
 #[command(
@@ -357,7 +359,7 @@ fn run(cli: Cli) -> anyhow::Result<()> {
             let mut runs = Vec::new();
             let mut loaded = Vec::new();
             for dir in &datasets {
-                let d = eval::load(dir)?;
+                let d = datasets::load(dir)?;
                 loaded.push(d.clone());
                 let mut tallies = Vec::new();
                 for (k, (which, det)) in detectors.iter().enumerate() {
@@ -372,18 +374,18 @@ fn run(cli: Cli) -> anyhow::Result<()> {
                 runs.extend(train::run_dataset(&d)?);
             }
             println!("The recordings as read (stamps, repeated samples, holes and what the core did with them):\n");
-            print!("{}", eval::data_table(&loaded)?);
+            print!("{}", tables::data_table(&loaded)?);
             println!(
                 "\nStrides, gait events and phases by the default detector (`{}`):\n",
                 Detector::ALL[0].name()
             );
-            print!("{}", eval::table(&results));
-            let rows: Vec<(&str, &str, &eval::Tally)> = side_by_side
+            print!("{}", tables::table(&results));
+            let rows: Vec<(&str, &str, &matching::Tally)> = side_by_side
                 .iter()
                 .flat_map(|(name, t)| t.iter().map(move |(d, t)| (name.as_str(), d.name(), t)))
                 .collect();
             println!("\nStep detectors side by side (cycle: every-pace stance instants, the default; stance: Huang's variance + IQR stance detector; lu: Lu's peak-valley detection):\n");
-            print!("{}", eval::detectors_table(&rows));
+            print!("{}", tables::detectors_table(&rows));
             let hyper = train::hyper_from(&gaitclip::trained::HYPER);
             let mut by = Vec::new();
             for v in length_eval::Validation::ALL {
