@@ -3,7 +3,7 @@
 //!
 //! - **in-sample**: every model fitted on every training stride (`gaitmap_walk` and
 //!   `pyshoe_vicon`), the scored ones included: what a fit can do on its own data;
-//! - **5-fold by trial**: the training datasets cut into [`train::FOLDS`] folds grouped by
+//! - **5-fold by trial**: the training datasets cut into [`cross_validation::FOLDS`] folds grouped by
 //!   trial, each fold predicted by models fitted on the others (the shipped SVR
 //!   hyper-parameters): new walks of the same people, sensors and rooms;
 //! - **leave-one-dataset-out**: each training dataset predicted by models fitted on the
@@ -31,7 +31,11 @@ use std::fmt::Write as _;
 use anyhow::Result;
 use gaitclip::models::{self, Model, ModelParams, MODELS};
 
-use crate::train::{self, HyperSet, Sample, Trained, TrialRun, TRAINING_DATASETS};
+use crate::cross_validation;
+use crate::fit::{self, HyperSet, Sample, Trained};
+use crate::plot::{Plot, COLOURS};
+use crate::stats::median;
+use crate::train::{self, TrialRun, TRAINING_DATASETS};
 
 /// Predictions of every model for every stride of every run: `[run][stride][model]`, m.
 pub type Predictions = Vec<Vec<[f64; MODELS]>>;
@@ -53,14 +57,14 @@ fn predict_run(run: &TrialRun, params: &ModelParams) -> Vec<[f64; MODELS]> {
 /// Cross-validated fixed-point predictions for `runs`, and the fit on all training strides.
 pub fn cross_validate(runs: &[TrialRun], hyper: &HyperSet) -> Result<(Predictions, Trained)> {
     let samples = train::samples(runs);
-    let fold = train::folds(samples.iter().map(|s| s.group.clone()));
+    let fold = cross_validation::folds(samples.iter().map(|s| s.group.clone()));
     let fits: Vec<Result<Trained>> = std::thread::scope(|sc| {
-        let handles: Vec<_> = (0..train::FOLDS)
+        let handles: Vec<_> = (0..cross_validation::FOLDS)
             .map(|k| {
                 let (samples, fold) = (&samples, &fold);
                 sc.spawn(move || {
                     let tr: Vec<&Sample> = samples.iter().filter(|s| fold[&s.group] != k).collect();
-                    train::fit_all(&tr, hyper)
+                    fit::fit_all(&tr, hyper)
                 })
             })
             .collect();
@@ -71,7 +75,7 @@ pub fn cross_validate(runs: &[TrialRun], hyper: &HyperSet) -> Result<(Prediction
     });
     let fits: Vec<Trained> = fits.into_iter().collect::<Result<_>>()?;
     let all: Vec<&Sample> = samples.iter().collect();
-    let full = train::fit_all(&all, hyper)?;
+    let full = fit::fit_all(&all, hyper)?;
     let mut out = Vec::new();
     for run in runs {
         let group = format!("{}/{}", run.dataset, run.trial);
@@ -89,7 +93,7 @@ pub fn cross_validate(runs: &[TrialRun], hyper: &HyperSet) -> Result<(Prediction
 pub enum Validation {
     /// Fitted on every training stride.
     InSample,
-    /// [`train::FOLDS`]-fold by trial.
+    /// [`cross_validation::FOLDS`]-fold by trial.
     KFold,
     /// Fitted on the other training dataset.
     LeaveOneDatasetOut,
@@ -119,7 +123,7 @@ fn dataset_of(s: &Sample) -> &str {
 
 /// Fixed-point predictions of every model for `runs`, validated as `v`: in-sample and
 /// k-fold with the SVR hyper-parameters `hyper`; leave-one-dataset-out chooses its own on
-/// the dataset it fits ([`train::choose_hyper`]), so that nothing of the scored dataset
+/// the dataset it fits ([`cross_validation::choose_hyper`]), so that nothing of the scored dataset
 /// reaches the model.
 pub fn predictions(runs: &[TrialRun], hyper: &HyperSet, v: Validation) -> Result<Predictions> {
     match v {
@@ -127,7 +131,7 @@ pub fn predictions(runs: &[TrialRun], hyper: &HyperSet, v: Validation) -> Result
         Validation::InSample => {
             let samples = train::samples(runs);
             let all: Vec<&Sample> = samples.iter().collect();
-            let full = train::fit_all(&all, hyper)?;
+            let full = fit::fit_all(&all, hyper)?;
             Ok(runs
                 .iter()
                 .map(|run| full.with_params(|p| predict_run(run, p)))
@@ -136,7 +140,7 @@ pub fn predictions(runs: &[TrialRun], hyper: &HyperSet, v: Validation) -> Result
         Validation::LeaveOneDatasetOut => {
             let samples = train::samples(runs);
             let all: Vec<&Sample> = samples.iter().collect();
-            let full = train::fit_all(&all, hyper)?;
+            let full = fit::fit_all(&all, hyper)?;
             let mut fits: BTreeMap<&str, Trained> = BTreeMap::new();
             for left_out in TRAINING_DATASETS {
                 let rest: Vec<Sample> = samples
@@ -147,9 +151,9 @@ pub fn predictions(runs: &[TrialRun], hyper: &HyperSet, v: Validation) -> Result
                 if rest.is_empty() || rest.len() == samples.len() {
                     continue;
                 }
-                let (h, _) = train::choose_hyper(&rest)?;
+                let (h, _) = cross_validation::choose_hyper(&rest)?;
                 let refs: Vec<&Sample> = rest.iter().collect();
-                fits.insert(left_out, train::fit_all(&refs, &h)?);
+                fits.insert(left_out, fit::fit_all(&refs, &h)?);
             }
             Ok(runs
                 .iter()
@@ -313,8 +317,6 @@ pub fn score(runs: &[TrialRun], pred: &Predictions) -> Vec<DatasetScores> {
         })
         .collect()
 }
-
-use crate::stats::median;
 
 /// The Markdown table: one row per model, per dataset RMSE / MAE / bias in cm and the
 /// walked-distance error (median / worst trial, %).
@@ -490,8 +492,7 @@ pub fn walked_table(runs: &[TrialRun], pred: &Predictions, model: Model) -> Stri
 
 /// Stride-length error of `model` against the reference stride's speed, one colour per
 /// dataset with per-stride lengths, as an SVG document.
-pub fn speed_plot(runs: &[TrialRun], pred: &Predictions, model: Model) -> String {
-    const COLOURS: [&str; 4] = ["#1f77b4", "#ff7f0e", "#2ca02c", "#9467bd"];
+pub fn speed_plot(runs: &[TrialRun], pred: &Predictions, model: Model) -> Result<String> {
     let mut by: Vec<(String, Vec<(f64, f64)>)> = Vec::new();
     for (run, p) in runs.iter().zip(pred) {
         for ((r, v), p) in run.reference.iter().zip(&run.speed_mps).zip(p) {
@@ -522,10 +523,9 @@ pub fn speed_plot(runs: &[TrialRun], pred: &Predictions, model: Model) -> String
     plot.line((0.0, 0.0), (vmax, 0.0), "", true);
     for (k, (d, pts)) in by.iter().enumerate() {
         let colour = COLOURS[k % COLOURS.len()];
-        plot.points_in(pts, colour);
-        plot.legend(k, &format!("{d} ({} strides)", pts.len()), colour);
+        plot.points(pts, colour, Some(format!("{d} ({} strides)", pts.len())));
     }
-    plot.finish()
+    plot.svg()
 }
 
 /// Matched clean strides of the training datasets: (reference, predicted by `model`), m.
@@ -541,129 +541,9 @@ pub fn pairs(runs: &[TrialRun], pred: &Predictions, model: Model) -> Vec<(f64, f
     out
 }
 
-struct Plot {
-    svg: String,
-    x: (f64, f64),
-    y: (f64, f64),
-}
-
-const W: f64 = 520.0;
-const H: f64 = 420.0;
-const MARGIN: f64 = 60.0;
-
-impl Plot {
-    fn new(title: &str, xlabel: &str, ylabel: &str, x: (f64, f64), y: (f64, f64)) -> Plot {
-        let mut svg = format!(
-            "<svg xmlns=\"http://www.w3.org/2000/svg\" width=\"{W}\" height=\"{H}\" font-family=\"sans-serif\" font-size=\"12\">\n<rect width=\"100%\" height=\"100%\" fill=\"white\"/>\n"
-        );
-        let _ = writeln!(
-            svg,
-            "<text x=\"{}\" y=\"20\" text-anchor=\"middle\" font-size=\"14\">{title}</text>",
-            W / 2.0
-        );
-        let _ = writeln!(
-            svg,
-            "<text x=\"{}\" y=\"{}\" text-anchor=\"middle\">{xlabel}</text>",
-            W / 2.0,
-            H - 12.0
-        );
-        let _ = writeln!(
-            svg,
-            "<text x=\"16\" y=\"{}\" text-anchor=\"middle\" transform=\"rotate(-90 16 {})\">{ylabel}</text>",
-            H / 2.0,
-            H / 2.0
-        );
-        let mut p = Plot { svg, x, y };
-        p.axes();
-        p
-    }
-
-    fn px(&self, v: f64) -> f64 {
-        MARGIN + (v - self.x.0) / (self.x.1 - self.x.0) * (W - 1.5 * MARGIN)
-    }
-
-    fn py(&self, v: f64) -> f64 {
-        H - MARGIN - (v - self.y.0) / (self.y.1 - self.y.0) * (H - 1.8 * MARGIN)
-    }
-
-    fn axes(&mut self) {
-        let (x0, x1, y0, y1) = (
-            self.px(self.x.0),
-            self.px(self.x.1),
-            self.py(self.y.0),
-            self.py(self.y.1),
-        );
-        let _ = writeln!(
-            self.svg,
-            "<rect x=\"{x0:.1}\" y=\"{y1:.1}\" width=\"{:.1}\" height=\"{:.1}\" fill=\"none\" stroke=\"black\"/>",
-            x1 - x0,
-            y0 - y1
-        );
-        for k in 0..=4 {
-            let vx = self.x.0 + (self.x.1 - self.x.0) * k as f64 / 4.0;
-            let vy = self.y.0 + (self.y.1 - self.y.0) * k as f64 / 4.0;
-            let _ = writeln!(
-                self.svg,
-                "<text x=\"{:.1}\" y=\"{:.1}\" text-anchor=\"middle\">{vx:.2}</text>\n<text x=\"{:.1}\" y=\"{:.1}\" text-anchor=\"end\">{vy:.2}</text>",
-                self.px(vx),
-                y0 + 16.0,
-                x0 - 4.0,
-                self.py(vy) + 4.0
-            );
-        }
-    }
-
-    fn points(&mut self, pts: &[(f64, f64)]) {
-        self.points_in(pts, "#1f77b4");
-    }
-
-    fn points_in(&mut self, pts: &[(f64, f64)], colour: &str) {
-        for &(x, y) in pts {
-            let _ = writeln!(
-                self.svg,
-                "<circle cx=\"{:.1}\" cy=\"{:.1}\" r=\"2\" fill=\"{colour}\" fill-opacity=\"0.5\"/>",
-                self.px(x.clamp(self.x.0, self.x.1)),
-                self.py(y.clamp(self.y.0, self.y.1))
-            );
-        }
-    }
-
-    fn legend(&mut self, row: usize, label: &str, colour: &str) {
-        let (x, y) = (
-            self.px(self.x.0) + 10.0,
-            self.py(self.y.1) + 16.0 + 16.0 * row as f64,
-        );
-        let _ = writeln!(
-            self.svg,
-            "<circle cx=\"{x:.1}\" cy=\"{:.1}\" r=\"4\" fill=\"{colour}\"/><text x=\"{:.1}\" y=\"{y:.1}\">{label}</text>",
-            y - 4.0,
-            x + 8.0
-        );
-    }
-
-    fn line(&mut self, a: (f64, f64), b: (f64, f64), label: &str, dash: bool) {
-        let _ = writeln!(
-            self.svg,
-            "<line x1=\"{:.1}\" y1=\"{:.1}\" x2=\"{:.1}\" y2=\"{:.1}\" stroke=\"#d62728\"{}/>\n<text x=\"{:.1}\" y=\"{:.1}\" text-anchor=\"end\" fill=\"#d62728\">{label}</text>",
-            self.px(a.0),
-            self.py(a.1),
-            self.px(b.0),
-            self.py(b.1),
-            if dash { " stroke-dasharray=\"5,4\"" } else { "" },
-            self.px(b.0) - 2.0,
-            self.py(b.1) - 4.0
-        );
-    }
-
-    fn finish(mut self) -> String {
-        self.svg.push_str("</svg>\n");
-        self.svg
-    }
-}
-
 /// A Bland–Altman plot (difference against mean, with the bias and the 95 % limits of
 /// agreement) and a predicted-against-reference scatter, as SVG documents.
-pub fn plots(pairs: &[(f64, f64)], model: &str) -> (String, String) {
+pub fn plots(pairs: &[(f64, f64)], model: &str) -> Result<(String, String)> {
     let n = pairs.len() as f64;
     let diffs: Vec<f64> = pairs.iter().map(|(r, p)| p - r).collect();
     let bias = diffs.iter().sum::<f64>() / n;
@@ -686,7 +566,7 @@ pub fn plots(pairs: &[(f64, f64)], model: &str) -> (String, String) {
         (-span, span),
     );
     let means: Vec<(f64, f64)> = pairs.iter().map(|(r, p)| ((r + p) / 2.0, p - r)).collect();
-    ba.points(&means);
+    ba.points(&means, COLOURS[0], None);
     ba.line(
         (lo, bias),
         (hi, bias),
@@ -706,7 +586,7 @@ pub fn plots(pairs: &[(f64, f64)], model: &str) -> (String, String) {
         (lo, hi),
         (lo, hi),
     );
-    sc.points(pairs);
+    sc.points(pairs, COLOURS[0], None);
     sc.line((lo, lo), (hi, hi), "y = x", true);
-    (ba.finish(), sc.finish())
+    Ok((ba.svg()?, sc.svg()?))
 }

@@ -3,21 +3,26 @@
 //! firmware in QEMU with its defmt log decoded.
 
 pub mod clock;
+pub mod codegen;
 pub mod cost;
+pub mod cross_validation;
 pub mod csv_trace;
 pub mod cycle_ref;
 pub mod datasets;
 pub mod eval;
 pub mod firmware;
+pub mod fit;
 pub mod fixtures;
 pub mod fuzzing;
 pub mod hole_sweep;
+pub mod insn_count;
 
 pub mod length_eval;
 pub mod length_ref;
 pub mod matching;
 pub mod mcap_io;
 pub mod peak_valley_ref;
+pub mod plot;
 pub mod qemu;
 pub mod reference;
 pub mod replay;

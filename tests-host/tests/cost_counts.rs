@@ -4,8 +4,9 @@
 //! detector and with Lu's peak-valley detector.
 
 use gaitclip::pipeline::{Config, Detector};
-use gaitclip_host::cost::{self, size_of_elf};
+use gaitclip_host::cost::size_of_elf;
 use gaitclip_host::firmware::{self, repo_root};
+use gaitclip_host::insn_count;
 use gaitclip_host::qemu;
 use gaitclip_host::replay::core_strides;
 
@@ -44,8 +45,8 @@ fn bench_counts_are_complete_and_repeatable_on_m4() {
         .expect("the benchmark firmware builds");
     let plugin = plugin();
     let scratch = tempdir("m4");
-    let a = cost::run_bench(&elf, qemu::MACHINE_M4, &plugin, &scratch).expect("counted run");
-    let b = cost::run_bench(&elf, qemu::MACHINE_M4, &plugin, &scratch).expect("counted run");
+    let a = insn_count::run_bench(&elf, qemu::MACHINE_M4, &plugin, &scratch).expect("counted run");
+    let b = insn_count::run_bench(&elf, qemu::MACHINE_M4, &plugin, &scratch).expect("counted run");
 
     let counts = gaitclip_host::fixtures::firmware_trace_counts().expect("demo trace");
     let host = core_strides(&counts, demo_config());
@@ -83,9 +84,9 @@ fn peak_valley_bench_counts_are_complete_and_repeatable_on_m4() {
     .expect("the benchmark firmware builds with the peak-valley detector");
     let plugin = plugin();
     let scratch = tempdir("m4-peak-valley");
-    let a = cost::run_bench_peak_valley(&elf, qemu::MACHINE_M4, &plugin, &scratch)
+    let a = insn_count::run_bench_peak_valley(&elf, qemu::MACHINE_M4, &plugin, &scratch)
         .expect("counted run");
-    let b = cost::run_bench_peak_valley(&elf, qemu::MACHINE_M4, &plugin, &scratch)
+    let b = insn_count::run_bench_peak_valley(&elf, qemu::MACHINE_M4, &plugin, &scratch)
         .expect("counted run");
 
     let counts = gaitclip_host::fixtures::firmware_trace_counts().expect("demo trace");
@@ -124,14 +125,15 @@ fn bench_runs_to_the_end_on_m0_with_each_detector() {
             .expect("the benchmark firmware builds for the M0");
         match detector {
             Detector::Cycle | Detector::Stance => {
-                let r = cost::run_bench(&elf, qemu::MACHINE_M0, &plugin, &scratch)
+                let r = insn_count::run_bench(&elf, qemu::MACHINE_M0, &plugin, &scratch)
                     .expect("counted run on the M0");
                 assert_eq!(r.samples as usize, counts.len());
                 assert!(r.strides > 0 && r.stride.n == r.strides as usize);
             }
             Detector::PeakValley => {
-                let r = cost::run_bench_peak_valley(&elf, qemu::MACHINE_M0, &plugin, &scratch)
-                    .expect("counted run on the M0");
+                let r =
+                    insn_count::run_bench_peak_valley(&elf, qemu::MACHINE_M0, &plugin, &scratch)
+                        .expect("counted run on the M0");
                 let mut config = demo_config();
                 config.detector = Detector::PeakValley;
                 let host = core_strides(&counts, config);

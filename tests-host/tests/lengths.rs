@@ -8,8 +8,8 @@ use gaitclip::models::{self, Model, Settings, MAX_TERMS};
 use gaitclip::phase_stats::StrideStats;
 use gaitclip::rate::SampleRate;
 use gaitclip::stride::Stride;
+use gaitclip_host::fit::least_squares;
 use gaitclip_host::length_ref;
-use gaitclip_host::train::least_squares;
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 

@@ -12,7 +12,7 @@ use gaitclip::features::Features;
 use gaitclip::models::{self, Model};
 use gaitclip::pipeline::DEFAULT_MODEL;
 use gaitclip_host::datasets::root_or_skip;
-use gaitclip_host::{datasets, train};
+use gaitclip_host::{codegen, datasets, train};
 
 #[test]
 fn shipped_models_are_current_exact_and_meet_targets() {
@@ -26,7 +26,7 @@ fn shipped_models_are_current_exact_and_meet_targets() {
 
     // 1. Not stale.
     let t = train::train(&runs).unwrap();
-    let source = train::rust_source(&t);
+    let source = codegen::rust_source(&t);
     let committed =
         std::fs::read_to_string(concat!(env!("CARGO_MANIFEST_DIR"), "/../src/trained.rs")).unwrap();
     assert!(

@@ -10,7 +10,8 @@ use gaitclip::pipeline::{Config, Detector};
 use gaitclip_host::eval;
 use gaitclip_host::trace::{Ranges, Trace};
 use gaitclip_host::{
-    csv_trace, datasets, fixtures, length_eval, matching, mcap_io, replay, tables, train,
+    codegen, csv_trace, datasets, fit, fixtures, length_eval, matching, mcap_io, replay, tables,
+    train,
 };
 
 #[derive(Parser)]
@@ -386,7 +387,7 @@ fn run(cli: Cli) -> anyhow::Result<()> {
                 .collect();
             println!("\nStep detectors side by side (cycle: every-pace stance instants, the default; stance: Huang's variance + IQR stance detector; lu: Lu's peak-valley detection):\n");
             print!("{}", tables::detectors_table(&rows));
-            let hyper = train::hyper_from(&gaitclip::trained::HYPER);
+            let hyper = fit::hyper_from(&gaitclip::trained::HYPER);
             let mut by = Vec::new();
             for v in length_eval::Validation::ALL {
                 let pred = length_eval::predictions(&runs, &hyper, v)?;
@@ -426,13 +427,13 @@ fn run(cli: Cli) -> anyhow::Result<()> {
                 let pairs = length_eval::pairs(&runs, lodo_pred, model);
                 let mut files = Vec::new();
                 if !pairs.is_empty() {
-                    let (ba, sc) = length_eval::plots(&pairs, model.name());
+                    let (ba, sc) = length_eval::plots(&pairs, model.name())?;
                     files.push(("bland_altman.svg", ba));
                     files.push(("scatter.svg", sc));
                 }
                 files.push((
                     "error_by_speed.svg",
-                    length_eval::speed_plot(&runs, lodo_pred, model),
+                    length_eval::speed_plot(&runs, lodo_pred, model)?,
                 ));
                 for (name, svg) in files {
                     let p = dir.join(name);
@@ -444,7 +445,7 @@ fn run(cli: Cli) -> anyhow::Result<()> {
         Cmd::Train { datasets, out } => {
             let runs = train::load_training(&datasets)?;
             let t = train::train(&runs)?;
-            std::fs::write(&out, train::rust_source(&t))
+            std::fs::write(&out, codegen::rust_source(&t))
                 .with_context(|| format!("writing {}", out.display()))?;
             eprintln!(
                 "trained on {} strides of {} trials; best leave-one-dataset-out (the default): {}; wrote {}",
