@@ -214,10 +214,15 @@ macro_rules! detectors {
                 Detector::ALL.iter().copied().find(|d| d.name() == name)
             }
 
+            /// The model it measures its strides with whatever the configured one, if any
+            /// ([`StepDetector::OWN_MODEL`]).
+            pub const fn own_model(self) -> Option<Model> {
+                own_model::<1>(self)
+            }
+
             /// The model behind its strides' lengths when `configured` is the configured one.
             pub const fn length_model(self, configured: Model) -> Model {
-                let own = own_model::<1>(self);
-                match own {
+                match self.own_model() {
                     Some(m) => m,
                     None => configured,
                 }

@@ -29,13 +29,13 @@ log=$(mktemp)
 cargo test 2>&1 | tee "$log"
 RUSTDOCFLAGS="-D warnings" cargo doc --no-deps
 
-echo "== firmware: clippy and release builds of every board (each for its target) and the benchmark (both)"
-for pkg in mps2-an386:thumbv7em-none-eabihf microbit:thumbv6m-none-eabi \
-  nrf52840-dk:thumbv7em-none-eabihf rp-pico:thumbv6m-none-eabi \
-  bench:thumbv7em-none-eabihf bench:thumbv6m-none-eabi; do
-  p="gaitclip-${pkg%%:*}" t=${pkg#*:}
-  cargo clippy --release -p "$p" --target "$t" -- -D warnings
-  cargo build --release -p "$p" --target "$t"
+echo "== firmware: clippy and release builds of every board and the benchmark, each for its target(s)"
+# Every folder under boards/ with a .cargo/config.toml is a firmware package: built from its
+# folder, it builds for the target(s) that file names (the benchmark for both).
+for dir in "$root"/boards/*/; do
+  [ -f "$dir/.cargo/config.toml" ] || continue
+  echo "-- ${dir#"$root"/}"
+  (cd "$dir" && cargo clippy --release -- -D warnings && cargo build --release)
 done
 cargo clippy --release -p gaitclip --target thumbv6m-none-eabi -- -D warnings
 

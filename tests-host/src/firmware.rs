@@ -72,13 +72,16 @@ pub fn build_for(
     match detector {
         // The firmware's default detector.
         Detector::Cycle => build_with(dir, bin, target, &[], env),
-        Detector::Stance => {
-            anyhow::bail!("the firmware runs the cycle or the peak-valley detector, not Huang's stance detector")
-        }
         Detector::PeakValley => {
             let mut env = env.to_vec();
             env.push(("CARGO_TARGET_DIR", "target/peak-valley".as_ref()));
             build_with(dir, bin, target, &["--features", PEAK_VALLEY_FEATURE], &env)
+        }
+        other => {
+            anyhow::bail!(
+                "the firmware runs the cycle or the peak-valley detector, not {}",
+                other.name()
+            )
         }
     }
 }

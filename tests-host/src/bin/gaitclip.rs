@@ -276,12 +276,14 @@ fn run(cli: Cli) -> anyhow::Result<()> {
             mcap_out,
         } => {
             let detector = Detector::from_name(&detector).context("unknown detector")?;
-            let model = match (detector, model.as_deref()) {
-                (_, Some(name)) => Model::from_name(name).context("unknown model")?,
-                (Detector::Cycle | Detector::Stance, None) => gaitclip::pipeline::DEFAULT_MODEL,
-                (Detector::PeakValley, None) => Model::LuFuzzy,
+            let model = match model.as_deref() {
+                Some(name) => Model::from_name(name).context("unknown model")?,
+                None => detector.length_model(gaitclip::pipeline::DEFAULT_MODEL),
             };
-            if detector == Detector::PeakValley && (model != Model::LuFuzzy || all_models) {
+            if detector
+                .own_model()
+                .is_some_and(|own| model != own || all_models)
+            {
                 return Err(UsageError(
                     "the lu detector's steps are measured by Lu's own chain only: --model lu_fuzzy, without --all-models",
                 )
