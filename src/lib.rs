@@ -25,18 +25,25 @@
 //!    clipped gyro lost. Huang's [`phases`] splitter gives toe-off and heel-strike, and
 //!    [`phase_stats`] sums the movement's acceleration phase by phase.
 //! 5. [`stance`] and [`stride`] — Huang's variance + IQR stance detector and its
-//!    stance-to-stance segmentation, kept selectable as the paper's method for the
-//!    side-by-side tables ([`pipeline::Detector::Stance`]).
+//!    stance-to-stance segmentation ([`stride::StanceStrides`]), kept selectable as the
+//!    paper's method for the side-by-side tables ([`detector::Detector::Stance`]).
 //! 6. [`features`] — Huang's per-phase features (Table 2) in Q16.
 //! 7. [`models`] — every paper's stride-length model side by side ([`fuzzy`] for Lu's K,
 //!    [`svr`] for Huang's RBF SVRs), with the coefficients and support vectors that
 //!    `gaitclip train` writes into [`trained`]; the pipeline's model fills in the length.
 //!
 //! [`pipeline::Pipeline`] composes them; a board or a host tool only feeds samples and
-//! reads strides. In place of stage 4 it can run Huang's stance detector (stage 5) or Lu's
-//! [`peak_valley`] detector on the vertical acceleration (after the [`low_pass`]), whose
-//! steps Lu's own chain measures ([`pipeline::Detector`]); the cycle detector is the
-//! default, because it alone gives every cycle of a jog its stance.
+//! reads strides. Stages 4 and 5 are step detectors behind one seam,
+//! [`detector::StepDetector`]: the pipeline is generic over it, so a firmware links only the
+//! detector it runs, and the host chooses at run time ([`detector::AnyDetector`]). Besides
+//! the cycle detector and Huang's, Lu's [`peak_valley`] detector works on the vertical
+//! acceleration (after the [`low_pass`]) and measures its steps with Lu's own chain; the
+//! cycle detector is the default, because it alone gives every cycle of a jog its stance.
+//!
+//! **Units are types where they cross a stage.** The stages take the sensor's scale as
+//! [`units::AccelScale`] and [`units::GyroScale`] (counts per g, per °/s), not the MPU6050's
+//! register enums, and the foot frame hands on [`units::FootAccel`] (g/2048 in the foot
+//! frame), not a bare `[i16; 3]` that a raw gyro reading could be passed as.
 //!
 //! **Integer on the sample path.** The per-sample work is integer arithmetic with documented
 //! scaling ([`fixed`]): Q30 quaternions, counts·2⁸ accelerations, `i64` integrals. The same

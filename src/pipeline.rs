@@ -12,12 +12,13 @@
 //! windows are undone by delay lines, so that every stride index is the number of the raw
 //! sample it names.
 //!
-//! **Three detectors.** [`Detector::Cycle`] (the default) replaces the stance detector and
-//! stride tracker above by [`crate::cycle::CycleDetector`]: one zero-velocity instant per
-//! gait cycle, strides from instant to instant, the same phases, ZUPT and models.
-//! [`Detector::Stance`] is the chain above (Huang's method). [`Detector::PeakValley`] replaces the stance detector and stride tracker with Lu's
-//! peak-valley detector ([`crate::peak_valley`]) on the foot frame's vertical acceleration,
-//! and measures each of its steps with Lu's own chain, fuzzy `k` and Weinberg
+//! **Three detectors** behind one seam ([`crate::detector::StepDetector`]; the pipeline is
+//! generic over it): the default [`crate::cycle::CycleDetector`] replaces the stance
+//! detector and stride tracker above by one zero-velocity instant per gait cycle, strides
+//! from instant to instant, the same phases, ZUPT and models;
+//! [`crate::stride::StanceStrides`] is the chain above (Huang's method);
+//! [`crate::peak_valley::PeakValleySteps`] is Lu's peak-valley detector on the foot frame's
+//! vertical acceleration, each step measured with Lu's own chain, fuzzy `k` and Weinberg
 //! ([`crate::peak_valley::lu_chain_um`]):
 //!
 //! ```text
