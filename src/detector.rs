@@ -188,14 +188,14 @@ pub trait StepDetector {
 
 /// Declares the detectors: the [`Detector`] names and [`AnyDetector`], which runs the one a
 /// [`Config`] names. One line per detector: `Variant("name") => Type,` (the type may use the
-/// movement buffer's `M`).
+/// movement buffer's `M`), with doc comments if it wants more than its name.
 macro_rules! detectors {
     ($($(#[$doc:meta])* $v:ident($name:literal) => $ty:ty,)+) => {
         /// Which step detector segments the walk (the host's `--detector`; a firmware's
         /// pipeline type).
         #[derive(Clone, Copy, Debug, PartialEq, Eq)]
         pub enum Detector {
-            $($(#[$doc])* $v,)+
+            $(#[doc = concat!("`", $name, "`.")] $(#[$doc])* $v,)+
         }
 
         impl Detector {
@@ -240,7 +240,7 @@ macro_rules! detectors {
         #[derive(Clone, Debug)]
         #[allow(clippy::large_enum_variant)] // sharing the memory is the point
         pub enum AnyDetector<const M: usize> {
-            $($(#[$doc])* $v($ty),)+
+            $(#[doc = concat!("`", $name, "`.")] $(#[$doc])* $v($ty),)+
         }
 
         impl<const M: usize> AnyDetector<M> {
