@@ -9,6 +9,92 @@ pub const Q30_ONE: i32 = 1 << 30;
 /// 1.0 in Q16 (features, model coefficients, fuzzy memberships).
 pub const Q16_ONE: i64 = 1 << 16;
 
+/// atan(2⁻ⁱ) in degrees · 2²⁴, i = 0..27: the CORDIC rotations of [`atan2_cdeg`].
+const ATAN_DEG_Q24: [i64; 28] = [
+    754_974_720,
+    445_687_602,
+    235_489_088,
+    119_537_938,
+    60_000_934,
+    30_029_717,
+    15_018_523,
+    7_509_720,
+    3_754_917,
+    1_877_466,
+    938_734,
+    469_367,
+    234_684,
+    117_342,
+    58_671,
+    29_335,
+    14_668,
+    7_334,
+    3_667,
+    1_833,
+    917,
+    458,
+    229,
+    115,
+    57,
+    29,
+    14,
+    7,
+];
+
+/// The angle of the vector `(x, y)` from the x axis, counter-clockwise positive, in
+/// centidegrees (hundredths of a degree), rounded: `atan2(y, x)` in (−18 000, 18 000].
+/// CORDIC in vectoring mode, 28 rotations: within 1 centidegree of the exact angle (host
+/// test). Range: any `x`, `y` with |x|, |y| < 2⁶²; `(0, 0)` gives 0.
+pub const fn atan2_cdeg(x: i64, y: i64) -> i32 {
+    if x == 0 && y == 0 {
+        return 0;
+    }
+    // Scaled so that the larger of |x|, |y| lies in [2⁵⁸, 2⁵⁹): full precision for small
+    // vectors, and room for the CORDIC gain (≈ 1.647) below 2⁶³.
+    let m = if x.unsigned_abs() > y.unsigned_abs() {
+        x.unsigned_abs()
+    } else {
+        y.unsigned_abs()
+    };
+    let lz = m.leading_zeros() as i32;
+    let (x, y) = if lz > 5 {
+        (x << (lz - 5), y << (lz - 5))
+    } else {
+        (x >> (5 - lz), y >> (5 - lz))
+    };
+    // Into the right half-plane, where the rotations converge (|angle| ≤ 99.9°).
+    let (mut x, mut y, mut acc) = if x < 0 {
+        if y >= 0 {
+            (-x, -y, 180i64 << 24)
+        } else {
+            (-x, -y, -(180i64 << 24))
+        }
+    } else {
+        (x, y, 0)
+    };
+    let mut i = 0;
+    while i < ATAN_DEG_Q24.len() {
+        let (dx, dy) = (y >> i, x >> i);
+        if y > 0 {
+            x += dx;
+            y -= dy;
+            acc += ATAN_DEG_Q24[i];
+        } else {
+            x -= dx;
+            y += dy;
+            acc -= ATAN_DEG_Q24[i];
+        }
+        i += 1;
+    }
+    // Degrees · 2²⁴ → centidegrees, rounded.
+    let c = (acc * 100 + (1 << 23)) >> 24;
+    if c <= -18_000 {
+        18_000
+    } else {
+        c as i32
+    }
+}
+
 /// Rounded `(a · b) >> 30` of two Q30 values.
 ///
 /// Range: any `a`, `b` whose exact product lies in [−2, 2); error ≤ 0.5 LSB.

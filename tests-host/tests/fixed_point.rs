@@ -329,7 +329,7 @@ fn mean_filter_with_shorter_window() {
 /// specific force, gyro bias from its mean rate, exact-normalised first-order attitude with
 /// the same |h|²/3 step correction,
 /// trapezoidal double integration, linear de-drift), in floating point and SI units.
-fn zupt_f64(stance: &[RawSample], movement: &[RawSample], rate_hz: f64) -> (f64, f64) {
+fn zupt_f64(stance: &[RawSample], movement: &[RawSample], rate_hz: f64) -> ZuptF64 {
     let (acc_lsb, gyr_lsb) = (2048.0 / 9.80665, 16.4 * 180.0 / std::f64::consts::PI);
     let n = stance.len() as f64;
     let mean_a = [0, 1, 2].map(|k| stance.iter().map(|s| s.accel[k] as f64).sum::<f64>() / n);
@@ -348,7 +348,9 @@ fn zupt_f64(stance: &[RawSample], movement: &[RawSample], rate_hz: f64) -> (f64,
         [-q1[1], q1[0], q1[3], -q1[2]]
     };
     let dt = 1.0 / rate_hz;
+    let att0 = att;
     let (mut v, mut p2) = ([0f64; 3], [0f64; 3]);
+    let mut heights = Vec::new();
     for s in movement {
         let h = [0, 1, 2].map(|k| (s.gyro[k] as f64 - bias[k]) / gyr_lsb * dt / 2.0);
         let h2: f64 = h.iter().map(|v| v * v).sum();
@@ -370,11 +372,50 @@ fn zupt_f64(stance: &[RawSample], movement: &[RawSample], rate_hz: f64) -> (f64,
             v[k] += a[k];
             p2[k] += prev + v[k];
         }
+        heights.push(p2[2]);
     }
     let nm = movement.len() as f64;
-    let disp = [0, 1, 2].map(|k| (p2[k] - v[k] * nm) / 2.0 * dt * dt * 9.80665 / g);
+    let si = dt * dt * 9.80665 / g / 2.0;
+    let disp = [0, 1, 2].map(|k| (p2[k] - v[k] * nm) * si);
+    // De-drifted height at every sample: the linear velocity error leaves v_N·c²/N.
+    let max_lift = heights
+        .iter()
+        .enumerate()
+        .map(|(i, &z2)| {
+            let c = (i + 1) as f64;
+            (z2 - v[2] * c * c / nm) * si
+        })
+        .fold(0.0f64, f64::max);
+    // The heading the x axis turned to under att ⊗ att0*.
+    let [w0, x0, y0, z0] = att0;
+    let r = quat_mul(att, [w0, -x0, -y0, -z0]);
+    let x_axis = rotate_f64(r, [1.0, 0.0, 0.0]);
     let _ = acc_lsb;
-    ((disp[0].powi(2) + disp[1].powi(2)).sqrt(), disp[2])
+    ZuptF64 {
+        horizontal: (disp[0].powi(2) + disp[1].powi(2)).sqrt(),
+        vertical: disp[2],
+        max_lift,
+        heading_deg: x_axis[1].atan2(x_axis[0]).to_degrees(),
+    }
+}
+
+/// What [`zupt_f64`] integrates, m and degrees.
+struct ZuptF64 {
+    horizontal: f64,
+    vertical: f64,
+    max_lift: f64,
+    heading_deg: f64,
+}
+
+fn quat_mul(a: [f64; 4], b: [f64; 4]) -> [f64; 4] {
+    let [w1, x1, y1, z1] = a;
+    let [w2, x2, y2, z2] = b;
+    [
+        w1 * w2 - x1 * x2 - y1 * y2 - z1 * z2,
+        w1 * x2 + x1 * w2 + y1 * z2 - z1 * y2,
+        w1 * y2 - x1 * z2 + y1 * w2 + z1 * x2,
+        w1 * z2 + x1 * y2 - y1 * x2 + z1 * w2,
+    ]
 }
 
 /// The fixed-point integrator agrees with the f64 reference within 1 mm on every stride of
@@ -398,7 +439,28 @@ fn zupt_displacement_matches_f64_reference_within_1mm() {
         assert!(z.start(&sums));
         movement.iter().for_each(|s| z.process(s));
         let d = z.displacement();
-        let (h, v) = zupt_f64(stance, movement, 200.0);
+        let ZuptF64 {
+            horizontal: h,
+            vertical: v,
+            max_lift,
+            heading_deg,
+        } = zupt_f64(stance, movement, 200.0);
+        // The lift over the kept points (every 2nd–8th sample here) against every sample:
+        // within the bound `LIFT_POINTS` documents.
+        assert!(
+            (d.max_lift_um as f64 * 1e-6 - max_lift).abs() < 1e-3,
+            "lift {} vs {max_lift}",
+            d.max_lift_um
+        );
+        assert!(max_lift > 0.02, "a stride lifts the foot: {max_lift}");
+        let turn = z.heading_change_cdeg() as f64 / 100.0;
+        // The heading of the integrated attitude: the Q30 integration differs from the f64
+        // one by up to 0.03° over the fixture's 90° turn (3·10⁻⁴ relative), the CORDIC by
+        // at most 0.01°.
+        assert!(
+            (turn - heading_deg).abs() <= 0.05,
+            "turn {turn} vs {heading_deg}"
+        );
         assert!(
             (d.horizontal_um as f64 * 1e-6 - h).abs() < 1e-3,
             "{} vs {h}",
@@ -412,6 +474,47 @@ fn zupt_displacement_matches_f64_reference_within_1mm() {
         checked += 1;
     }
     assert!(checked >= 20);
+}
+
+/// `atan2_cdeg` is within 1 centidegree of `atan2` in every quadrant, at the axes and for
+/// vectors from a few counts to 2⁶⁰.
+#[test]
+fn atan2_cdeg_within_one_centidegree() {
+    use gaitclip::fixed::atan2_cdeg;
+    let exact = |x: i64, y: i64| (y as f64).atan2(x as f64).to_degrees() * 100.0;
+    let check = |x: i64, y: i64| {
+        let got = atan2_cdeg(x, y);
+        let want = exact(x, y);
+        // Compared around the circle: −179.997° may round to the cut, +180.00°.
+        let diff = (got as f64 - want).rem_euclid(36_000.0);
+        assert!(
+            diff.min(36_000.0 - diff) <= 1.0,
+            "atan2({y}, {x}) = {got} cdeg, want {want}"
+        );
+        assert!((-18_000..=18_000).contains(&got) && got != -18_000);
+    };
+    for (x, y) in [
+        (1, 0),
+        (0, 1),
+        (-1, 0),
+        (0, -1),
+        (-5, -1),
+        (-5, 1),
+        (1 << 30, 1 << 30),
+        ((1 << 60) - 1, -(1 << 60) + 1),
+        (-(1 << 60) + 1, 0),
+        (3, 4),
+    ] {
+        check(x, y);
+    }
+    assert_eq!(atan2_cdeg(0, 0), 0);
+    assert_eq!(atan2_cdeg(-7, 0), 18_000);
+    let mut r = rng();
+    for _ in 0..100_000 {
+        let bits = r.random_range(4..60);
+        let m = 1i64 << bits;
+        check(r.random_range(-m..m), r.random_range(-m..m));
+    }
 }
 
 fn raw(v: [i16; 7]) -> RawSample {
