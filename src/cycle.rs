@@ -874,8 +874,7 @@ impl<const M: usize> CycleDetector<M> {
         // Events in order whatever the buffer held.
         let heel_strike = heel_strike.min(foot_flat).max(heel_off);
         let toe_off = toe_off.min(heel_strike).max(heel_off);
-        let d_ok = cur.broken.is_none();
-        Some(Stride {
+        let mut stride = Stride {
             index,
             start: cur.start,
             heel_off: heel_off.min(foot_flat),
@@ -883,20 +882,14 @@ impl<const M: usize> CycleDetector<M> {
             heel_strike,
             foot_flat,
             end: c.index,
-            length_mm: 0,
-            zupt_um: if d_ok {
-                d.horizontal_um.min(u32::MAX as u64) as u32
-            } else {
-                0
-            },
-            climb_mm: if d_ok {
-                ((d.vertical_um + 500).div_euclid(1000)).clamp(i32::MIN as i64, i32::MAX as i64)
-                    as i32
-            } else {
-                0
-            },
             flags: StrideFlags(flags),
-        })
+            ..Stride::default()
+        };
+        // No displacement across a hole.
+        if cur.broken.is_none() {
+            stride.set_trajectory(&d, c.snap.heading_change_cdeg());
+        }
+        Some(stride)
     }
 
     /// At the end of a recording: the candidate, if any, is the last stance (the stride

@@ -86,6 +86,7 @@ pub mod features;
 pub mod fixed;
 pub mod foot_frame;
 pub mod fuzzy;
+pub mod gait;
 pub mod low_pass;
 pub mod mean_filter;
 pub mod models;

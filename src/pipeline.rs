@@ -31,6 +31,7 @@ use crate::cycle::Calibration;
 pub use crate::detector::Detector;
 use crate::detector::{AnyDetector, DelayLines, Drain, Input, StepDetector};
 use crate::foot_frame::FootFrameEstimator;
+use crate::gait::GaitTimer;
 use crate::mean_filter::MeanFilter;
 use crate::models::{LengthChain, Model, ModelParams, Settings};
 use crate::phase_stats::StrideStats;
@@ -204,6 +205,8 @@ pub struct Pipeline<D = AnyDetector<MAX_MOVEMENT_SAMPLES>> {
     detector: D,
     lines: DelayLines,
     chain: LengthChain,
+    /// The last stage: gait parameters from the events and the length.
+    gait: GaitTimer,
     /// Accelerometer counts per g.
     accel_lsb_per_g: i32,
     /// Longest hole bridged / filled, samples.
@@ -254,6 +257,7 @@ impl<D: StepDetector> Pipeline<D> {
             frame: FootFrameEstimator::new(config.rate, config.accel, config.gyro),
             detector,
             lines: DelayLines::new(),
+            gait: GaitTimer::new(config.rate),
             chain: LengthChain {
                 model: config.model,
                 settings: config.settings,
@@ -343,7 +347,7 @@ impl<D: StepDetector> Pipeline<D> {
             self.step(s, Origin::Measured, &mut out);
         }
         if let Some(st) = out.as_mut() {
-            self.detector.measure(st, &self.chain);
+            self.complete(st);
         }
         out
     }
@@ -601,8 +605,14 @@ impl<D: StepDetector> Pipeline<D> {
     }
 
     /// The detector's length chain on a stride that is handed back.
-    fn measured(&self, mut s: Stride) -> Stride {
-        self.detector.measure(&mut s, &self.chain);
+    fn measured(&mut self, mut s: Stride) -> Stride {
+        self.complete(&mut s);
         s
+    }
+
+    /// The stages after the detector: the length, then the gait parameters that need it.
+    fn complete(&mut self, s: &mut Stride) {
+        self.detector.measure(s, &self.chain);
+        self.gait.process(s);
     }
 }

@@ -41,6 +41,7 @@ use heapless::Vec;
 use crate::detector::{Drain, Input, StepDetector};
 use crate::fixed::isqrt_u64;
 use crate::foot_frame::FOOT_LSB_PER_G;
+use crate::gait::GaitParameters;
 use crate::phase_stats::{StrideStats, CHANNELS};
 use crate::phases::{self, PhaseMethod};
 use crate::pipeline::Config;
@@ -49,7 +50,7 @@ use crate::rest::RestSums;
 use crate::sample::RawSample;
 use crate::stance::{StanceDetector, StanceThresholds};
 use crate::units::{FootAccel, GyroScale};
-use crate::zupt::ZuptIntegrator;
+use crate::zupt::{Displacement, ZuptIntegrator};
 
 /// Default capacity of the movement buffer: 1.024 s at 1 kHz, 5 s at 204.8 Hz, 10 s at
 /// 100 Hz (a walking movement, heel-off to foot-flat, lasts 0.5–1 s). 6 KiB of state.
@@ -144,6 +145,17 @@ pub struct Stride {
     pub zupt_um: u32,
     /// Height gained over the stride, mm (stairs, slopes).
     pub climb_mm: i32,
+    /// Highest point of the sensor above its start over the movement, mm (gaitmap's
+    /// `max_sensor_lift`, [`crate::zupt::Displacement::max_lift_um`]); 0 without a ZUPT
+    /// trajectory (Lu's steps, a gap).
+    pub max_sensor_lift_mm: u16,
+    /// Heading change over the movement, centidegrees, counter-clockwise seen from above
+    /// positive (gaitmap's `turning_angle`, [`crate::zupt::ZuptIntegrator::heading_change_cdeg`]);
+    /// 0 without a ZUPT trajectory.
+    pub turning_angle_cdeg: i16,
+    /// Timing, velocity, cadence, walking or running: the pipeline's last stage
+    /// ([`crate::gait`]), once the length is set.
+    pub gait: GaitParameters,
     /// Qualifiers.
     pub flags: StrideFlags,
 }
@@ -156,6 +168,16 @@ impl Stride {
             self.flags.0 |= StrideFlags::IMPLAUSIBLE;
         }
         self.length_mm = mm.min(MAX_STRIDE_MM);
+    }
+
+    /// Sets what the ZUPT trajectory of the movement gives: horizontal displacement, climb,
+    /// lift (rounded to mm, saturated) and the heading change.
+    pub fn set_trajectory(&mut self, d: &Displacement, turning_angle_cdeg: i16) {
+        self.zupt_um = d.horizontal_um.min(u32::MAX as u64) as u32;
+        self.climb_mm =
+            ((d.vertical_um + 500).div_euclid(1000)).clamp(i32::MIN as i64, i32::MAX as i64) as i32;
+        self.max_sensor_lift_mm = ((d.max_lift_um as u64 + 500) / 1000).min(u16::MAX as u64) as u16;
+        self.turning_angle_cdeg = turning_angle_cdeg;
     }
 }
 
@@ -588,7 +610,7 @@ impl<const M: usize> StrideTracker<M> {
         let slot = &mut self.stats[(index & 1) as usize];
         slot.0 = index;
         slot.1 = StrideStats::measure(&self.movement, split.toe_off, split.heel_strike);
-        let held = Stride {
+        let mut held = Stride {
             index,
             start,
             heel_off: self.heel_off,
@@ -596,12 +618,10 @@ impl<const M: usize> StrideTracker<M> {
             heel_strike,
             foot_flat,
             end: foot_flat,
-            length_mm: 0,
-            zupt_um: d.horizontal_um.min(u32::MAX as u64) as u32,
-            climb_mm: ((d.vertical_um + 500).div_euclid(1000))
-                .clamp(i32::MIN as i64, i32::MAX as i64) as i32,
             flags: StrideFlags(flags),
+            ..Stride::default()
         };
+        held.set_trajectory(&d, self.zupt.heading_change_cdeg());
         if self.pending.is_none() {
             self.pending = Some(held);
         } else {
