@@ -99,6 +99,35 @@ pub struct LoggedStride {
     pub climb_mm: i32,
     /// Flag bits.
     pub flags: u16,
+    /// Gait parameters: stance time, swing time (ms), stance ‰, velocity (mm/s), cadence
+    /// (steps/min), lift (mm), heading change (centidegrees), and the gait's name.
+    pub gait: [i32; 7],
+    /// `walking`, `running` or `unknown`.
+    pub gait_name: String,
+}
+
+impl LoggedStride {
+    /// What the firmware logs of a stride.
+    pub fn of(s: &gaitclip::stride::Stride) -> Self {
+        let g = &s.gait;
+        LoggedStride {
+            index: s.index,
+            idx: [s.start, s.heel_off, s.toe_off, s.heel_strike, s.end],
+            length_mm: s.length_mm,
+            climb_mm: s.climb_mm,
+            flags: s.flags.0,
+            gait: [
+                g.stance_time_ms as i32,
+                g.swing_time_ms as i32,
+                g.stance_permille as i32,
+                g.gait_velocity_mm_s as i32,
+                g.cadence_spm as i32,
+                s.max_sensor_lift_mm as i32,
+                s.turning_angle_cdeg as i32,
+            ],
+            gait_name: g.gait.name().to_string(),
+        }
+    }
 }
 
 /// Parses a line written by `boards/common/stride_log.rs`; `None` for other lines.
@@ -107,7 +136,14 @@ pub fn parse_stride_line(line: &str) -> Option<LoggedStride> {
     let mut fields = rest.split_whitespace();
     let index = fields.next()?.parse().ok()?;
     let (mut len, mut climb, mut flags, mut idx) = (None, None, None, None);
+    let (mut gait, mut gait_name) = (None, None);
+    let mut after_gait = false;
     for f in fields {
+        if after_gait {
+            gait_name = Some(f.to_string());
+            after_gait = false;
+            continue;
+        }
         if let Some(v) = f.strip_prefix("len=") {
             len = v.parse().ok();
         } else if let Some(v) = f.strip_prefix("climb=") {
@@ -117,6 +153,10 @@ pub fn parse_stride_line(line: &str) -> Option<LoggedStride> {
         } else if let Some(v) = f.strip_prefix("idx=") {
             let v: Vec<u32> = v.split(',').filter_map(|x| x.parse().ok()).collect();
             idx = v.try_into().ok();
+        } else if let Some(v) = f.strip_prefix("gait=") {
+            let v: Vec<i32> = v.split(',').filter_map(|x| x.parse().ok()).collect();
+            gait = v.try_into().ok();
+            after_gait = true;
         }
     }
     Some(LoggedStride {
@@ -125,5 +165,7 @@ pub fn parse_stride_line(line: &str) -> Option<LoggedStride> {
         length_mm: len?,
         climb_mm: climb?,
         flags: flags?,
+        gait: gait?,
+        gait_name: gait_name?,
     })
 }

@@ -27,7 +27,7 @@ pub const SUMMARY_SCHEMA: &str = "gaitclip.ReplaySummary";
 pub const SUMMARY_TOPIC: &str = "/summary";
 
 const IMU_JSON_SCHEMA: &str = r#"{"type":"object","title":"gaitclip.ImuSample","properties":{"t_s":{"type":"number","description":"time, s"},"acc":{"type":"array","items":{"type":"number"},"description":"specific force x,y,z, m/s^2, sensor axes"},"gyr":{"type":"array","items":{"type":"number"},"description":"angular rate x,y,z, rad/s"}}}"#;
-const STRIDE_JSON_SCHEMA: &str = r#"{"type":"object","title":"gaitclip.Stride","properties":{"index":{"type":"integer"},"start_s":{"type":"number"},"end_s":{"type":"number"},"length_m":{"type":"number"},"heel_off_s":{"type":"number"},"toe_off_s":{"type":"number"},"heel_strike_s":{"type":"number"},"foot_flat_s":{"type":"number"},"climb_m":{"type":"number"},"valid":{"type":"boolean"},"flags":{"type":"array","items":{"type":"string"}}}}"#;
+const STRIDE_JSON_SCHEMA: &str = r#"{"type":"object","title":"gaitclip.Stride","properties":{"index":{"type":"integer"},"start_s":{"type":"number"},"end_s":{"type":"number"},"length_m":{"type":"number"},"heel_off_s":{"type":"number"},"toe_off_s":{"type":"number"},"heel_strike_s":{"type":"number"},"foot_flat_s":{"type":"number"},"climb_m":{"type":"number"},"stride_time_s":{"type":"number"},"stance_time_s":{"type":"number"},"swing_time_s":{"type":"number"},"stance_pct":{"type":"number"},"swing_pct":{"type":"number"},"gait_velocity_m_s":{"type":"number"},"cadence_spm":{"type":"integer"},"max_sensor_lift_m":{"type":"number"},"turning_angle_deg":{"type":"number"},"gait":{"type":"string","enum":["walking","running","unknown"]},"valid":{"type":"boolean"},"flags":{"type":"array","items":{"type":"string"}}}}"#;
 
 /// gaitclip's IMU message.
 #[derive(Serialize, Deserialize)]

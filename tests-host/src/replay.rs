@@ -167,6 +167,27 @@ pub struct StrideReport {
     pub foot_flat_s: f64,
     /// Height gained, m.
     pub climb_m: f64,
+    /// One gait cycle, `end_s − start_s` on the sample grid, s (gaitmap's `stride_time`).
+    pub stride_time_s: f64,
+    /// Ground contact within the cycle, `stride_time − swing_time`, s.
+    pub stance_time_s: f64,
+    /// Toe-off to heel-strike, s.
+    pub swing_time_s: f64,
+    /// Stance time per stride time, %.
+    pub stance_pct: f64,
+    /// Swing time per stride time, %.
+    pub swing_pct: f64,
+    /// Length per stride time, m/s (gaitmap's `gait_velocity`).
+    pub gait_velocity_m_s: f64,
+    /// Steps per minute (two per cycle of the instrumented foot).
+    pub cadence_spm: u16,
+    /// Highest point of the sensor above its start, m (gaitmap's `max_sensor_lift`).
+    pub max_sensor_lift_m: f64,
+    /// Heading change over the movement, degrees, counter-clockwise seen from above
+    /// (gaitmap's `turning_angle`).
+    pub turning_angle_deg: f64,
+    /// `walking`, `running` (stance under half the cycle) or `unknown` (not one cycle).
+    pub gait: &'static str,
     /// False when the length is not to be trusted (see `flags`).
     pub valid: bool,
     /// Names of the flags set.
@@ -461,6 +482,16 @@ fn report(s: Stride, config: Config, t_s: &impl Fn(u32) -> f64) -> StrideReport 
         heel_strike_s: t_s(s.heel_strike),
         foot_flat_s: t_s(s.foot_flat),
         climb_m: s.climb_mm as f64 / 1000.0,
+        stride_time_s: s.gait.stride_time_ms as f64 / 1000.0,
+        stance_time_s: s.gait.stance_time_ms as f64 / 1000.0,
+        swing_time_s: s.gait.swing_time_ms as f64 / 1000.0,
+        stance_pct: s.gait.stance_permille as f64 / 10.0,
+        swing_pct: s.gait.swing_permille as f64 / 10.0,
+        gait_velocity_m_s: s.gait.gait_velocity_mm_s as f64 / 1000.0,
+        cadence_spm: s.gait.cadence_spm,
+        max_sensor_lift_m: s.max_sensor_lift_mm as f64 / 1000.0,
+        turning_angle_deg: s.turning_angle_cdeg as f64 / 100.0,
+        gait: s.gait.gait.name(),
         valid: s.flags.valid(),
         flags: flag_names(s.flags),
         raw: s,

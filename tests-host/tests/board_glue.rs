@@ -180,14 +180,26 @@ fn serial_stride_line_parses_back() {
         ..Default::default()
     };
     stride.flags.0 = gaitclip::stride::StrideFlags::FROM_REST;
+    stride.max_sensor_lift_mm = 131;
+    stride.turning_angle_cdeg = -215;
+    stride.gait = gaitclip::gait::GaitParameters::of(&stride, None, rate);
     let mut line = String::new();
     serial_line::stride(&mut line, rate, &stride).unwrap();
     assert!(line.len() <= serial_line::MAX_LINE);
     let body = line.strip_suffix("\r\n").expect("CRLF ending");
-    let f: Vec<i64> = body.split(',').map(|v| v.parse().unwrap()).collect();
+    let (numbers, gait) = body.rsplit_once(',').expect("the gait column");
+    assert_eq!(gait, "unknown", "a stride from rest is not one cycle");
+    let f: Vec<i64> = numbers.split(',').map(|v| v.parse().unwrap()).collect();
     let header: Vec<&str> = serial_line::HEADER.split(',').collect();
-    assert_eq!(f.len(), header.len());
-    assert_eq!(f, vec![7, 5000, 1362, 1105, 420, 150, 380, 155, -3, 4, 1]);
+    assert_eq!(f.len() + 1, header.len());
+    assert_eq!(
+        f,
+        vec![
+            7, 5000, 1362, 1105, 420, 150, 380, 155, -3, 4, 1, 725, 380, 656, 1233, 109, 131, -215
+        ]
+    );
+    // Stance and swing times add up to the stride time.
+    assert_eq!(f[11] + f[12], f[3]);
     // The phases add up to the stride.
     assert_eq!(f[4] + f[5] + f[6] + f[7], f[3]);
 

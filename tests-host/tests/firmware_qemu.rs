@@ -18,13 +18,7 @@ use gaitclip_host::trace::Ranges;
 const MICROBIT_MOVEMENT_SAMPLES: usize = 256;
 
 fn logged(s: &Stride) -> LoggedStride {
-    LoggedStride {
-        index: s.index,
-        idx: [s.start, s.heel_off, s.toe_off, s.heel_strike, s.end],
-        length_mm: s.length_mm,
-        climb_mm: s.climb_mm,
-        flags: s.flags.0,
-    }
+    LoggedStride::of(s)
 }
 
 /// The micro:bit firmware with the emulated sensor losing the runs of
@@ -219,19 +213,7 @@ fn strides_equal_host_replay(
     config.detector = detector;
     let host: Vec<LoggedStride> = replay_counts_with(&counts, config, |i| i as f64)
         .iter()
-        .map(|s| LoggedStride {
-            index: s.raw.index,
-            idx: [
-                s.raw.start,
-                s.raw.heel_off,
-                s.raw.toe_off,
-                s.raw.heel_strike,
-                s.raw.end,
-            ],
-            length_mm: s.raw.length_mm,
-            climb_mm: s.raw.climb_mm,
-            flags: s.raw.flags.0,
-        })
+        .map(|s| LoggedStride::of(&s.raw))
         .collect();
     assert!(host.len() >= 20, "host found {} strides", host.len());
     assert_eq!(on_target, host);

@@ -6,10 +6,10 @@
 //!
 //! ```text
 //! # gaitclip 0.1.0 board=nrf52840-dk rate_mhz=200000 detector=stance model=huang_svr_fusion
-//! index,t_ms,length_mm,duration_ms,stance_ms,push_off_ms,swing_ms,heel_strike_ms,climb_mm,flags,valid
+//! index,t_ms,length_mm,duration_ms,stance_ms,push_off_ms,swing_ms,heel_strike_ms,climb_mm,flags,valid,stance_time_ms,swing_time_ms,stance_permille,gait_velocity_mm_s,cadence_spm,max_sensor_lift_mm,turning_angle_cdeg,gait
 //! # hold still: waiting for the clip to rest (2 s)
 //! # still: gyro_bias_mdps=-1220,305,61 gravity_mg=1003
-//! 0,5120,1362,1105,420,150,380,155,3,4,1
+//! 0,5120,1362,1105,420,150,380,155,3,4,1,725,380,656,1233,109,131,-215,unknown
 //! # hole samples=12 filled: a stride whose movement it falls in is a gap stride (flag 64), without a length
 //! # status samples=24000 strides=96 distance_mm=131012 bus_errors=0 restarts=0 fifo_overflows=0 silences=0 overruns=0 lost_samples=0
 //! ```
@@ -19,7 +19,11 @@
 //! the bit set of [`gaitclip::stride::StrideFlags`] (1 saturated, 2 too long, 4 from rest,
 //! 8 to rest, 16 turn, 32 phases guessed, 64 gap, 128 implausible, 256 bridged, 512 gyro
 //! clipped and restored); `valid` is 0 when a flag
-//! makes the length untrustworthy (a gap stride has length 0).
+//! makes the length untrustworthy (a gap stride has length 0). The columns after `valid` are
+//! the stride's gait parameters ([`gaitclip::gait`], gaitmap's names): `duration_ms` is the
+//! `stride_time`; `stance_time_ms` is the ground contact within the cycle (both ends of it,
+//! unlike `stance_ms`, the part before heel-off); the heading change in centidegrees,
+//! counter-clockwise positive; `gait` is `walking`, `running` or `unknown` (not one cycle).
 //! `tests-host/tests/board_glue.rs` parses these lines back.
 
 use core::fmt::{self, Write};
@@ -36,7 +40,7 @@ use crate::imu_sampler::Counters;
 pub const MAX_LINE: usize = 256;
 
 /// The CSV header line.
-pub const HEADER: &str = "index,t_ms,length_mm,duration_ms,stance_ms,push_off_ms,swing_ms,heel_strike_ms,climb_mm,flags,valid";
+pub const HEADER: &str = "index,t_ms,length_mm,duration_ms,stance_ms,push_off_ms,swing_ms,heel_strike_ms,climb_mm,flags,valid,stance_time_ms,swing_time_ms,stance_permille,gait_velocity_mm_s,cadence_spm,max_sensor_lift_mm,turning_angle_cdeg,gait";
 
 /// The banner and the CSV header.
 pub fn banner(
@@ -63,7 +67,7 @@ pub fn stride(out: &mut impl Write, rate: SampleRate, s: &Stride) -> fmt::Result
     let ms = |a: u32, b: u32| rate.ms_of_samples(b.wrapping_sub(a));
     write!(
         out,
-        "{},{},{},{},{},{},{},{},{},{},{}\r\n",
+        "{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{}\r\n",
         s.index,
         rate.ms_of_samples(s.start),
         s.length_mm,
@@ -74,7 +78,15 @@ pub fn stride(out: &mut impl Write, rate: SampleRate, s: &Stride) -> fmt::Result
         ms(s.heel_strike, s.end),
         s.climb_mm,
         s.flags.0,
-        s.flags.valid() as u8
+        s.flags.valid() as u8,
+        s.gait.stance_time_ms,
+        s.gait.swing_time_ms,
+        s.gait.stance_permille,
+        s.gait.gait_velocity_mm_s,
+        s.gait.cadence_spm,
+        s.max_sensor_lift_mm,
+        s.turning_angle_cdeg,
+        s.gait.gait.name()
     )
 }
 

@@ -62,7 +62,7 @@ impl StrideLog {
         self.strides += 1;
         self.distance_mm += s.length_mm as u64;
         defmt::println!(
-            "stride {=u32} t={=u32} dur={=u32} len={=u32} climb={=i32} phases={=u32}/{=u32}/{=u32}/{=u32} ms flags={=u16} idx={=u32},{=u32},{=u32},{=u32},{=u32}",
+            "stride {=u32} t={=u32} dur={=u32} len={=u32} climb={=i32} phases={=u32}/{=u32}/{=u32}/{=u32} ms flags={=u16} idx={=u32},{=u32},{=u32},{=u32},{=u32} gait={=u16},{=u16},{=u16},{=u16},{=u16},{=u16},{=i16} {=str}",
             s.index,
             self.rate.ms_of_samples(s.start),
             ms(s.start, s.end),
@@ -77,7 +77,15 @@ impl StrideLog {
             s.heel_off,
             s.toe_off,
             s.heel_strike,
-            s.end
+            s.end,
+            s.gait.stance_time_ms,
+            s.gait.swing_time_ms,
+            s.gait.stance_permille,
+            s.gait.gait_velocity_mm_s,
+            s.gait.cadence_spm,
+            s.max_sensor_lift_mm,
+            s.turning_angle_cdeg,
+            s.gait.gait.name()
         );
         let _ = serial_line::stride(serial, self.rate, s);
     }
