@@ -122,6 +122,9 @@ pub struct Trial {
     pub unscored_s: Option<(f64, f64)>,
     /// Per-sample stance label, where the dataset has one.
     pub stance: Option<Vec<bool>>,
+    /// Per-sample Vicon foot position, m (`pyshoe_vicon`'s `<trial>.reference.csv`: x, y
+    /// horizontal, z up); NaN where the marker was lost.
+    pub positions: Option<Vec<[f64; 3]>>,
     /// The walker's height, m, where the dataset gives it.
     pub height_m: Option<f64>,
     /// Distance walked over `span`, m, where the dataset gives it (not per stride).
@@ -222,15 +225,31 @@ fn load_strides(dir: &Path, name: &str) -> Result<Vec<Trial>> {
             references.iter().map(|r| r.start).min().unwrap_or(0),
             references.iter().map(|r| r.end).max().unwrap_or(0),
         );
-        let stance = if name == "pyshoe_vicon" {
+        let (stance, positions) = if name == "pyshoe_vicon" {
             let p = dir.join(format!("{trial}.reference.csv"));
-            let mut v = Vec::new();
-            for row in read_rows(&p)? {
-                v.push(field(&row, "stance_vicon", &p)?.trim() == "1");
+            let (mut v, mut pos) = (Vec::new(), Vec::new());
+            for (line, row) in read_rows(&p)?.iter().enumerate() {
+                v.push(field(row, "stance_vicon", &p)?.trim() == "1");
+                let mut xyz = [f64::NAN; 3];
+                for (x, k) in xyz.iter_mut().zip(["pos_x_m", "pos_y_m", "pos_z_m"]) {
+                    let f = field(row, k, &p)?.trim();
+                    *x = if f.is_empty() || f.eq_ignore_ascii_case("nan") {
+                        f64::NAN
+                    } else {
+                        f.parse().with_context(|| {
+                            format!(
+                                "{}:{}: `{k}` = {f:?} is not a number",
+                                p.display(),
+                                line + 2
+                            )
+                        })?
+                    };
+                }
+                pos.push(xyz);
             }
-            Some(v)
+            (Some(v), Some(pos))
         } else {
-            None
+            (None, None)
         };
         trials.push(Trial {
             csv: dir.join(format!("{trial}.csv")),
@@ -239,6 +258,7 @@ fn load_strides(dir: &Path, name: &str) -> Result<Vec<Trial>> {
             span,
             span_s: None,
             stance,
+            positions,
             unscored_s: None,
             height_m: None,
             distance_m: None,
@@ -334,6 +354,7 @@ fn load_ipol(dir: &Path) -> Result<Vec<Trial>> {
             span_s: Some(span_s),
             unscored_s: Some(uturn_s),
             stance: None,
+            positions: None,
             height_m: height,
             distance_m: Some(distance),
         });

@@ -14,6 +14,7 @@ pub mod firmware;
 pub mod fit;
 pub mod fixtures;
 pub mod fuzzing;
+pub mod gait_eval;
 pub mod hole_sweep;
 pub mod insn_count;
 

@@ -77,6 +77,13 @@ enum Cmd {
         #[arg(long, value_name = "STD,IQR,GYRO", value_parser = stance_limits)]
         stance: Option<gaitclip::stance::StanceLimits>,
     },
+    /// Compare the per-stride gait parameters (times, cadence, velocity, lift, turning,
+    /// walking/running) with the references of dataset folders; prints Markdown tables.
+    Gait {
+        /// Dataset folders.
+        #[arg(required = true)]
+        datasets: Vec<PathBuf>,
+    },
     /// Train every stride-length model on the shared datasets with per-stride lengths and
     /// write the generated Rust source the firmware compiles.
     Train {
@@ -337,6 +344,14 @@ fn run(cli: Cli) -> anyhow::Result<()> {
                 )?;
                 eprintln!("wrote {}", out.display());
             }
+        }
+        Cmd::Gait { datasets } => {
+            let mut results = Vec::new();
+            for dir in &datasets {
+                let d = datasets::load(dir)?;
+                results.push((d.name.clone(), gaitclip_host::gait_eval::evaluate(&d)?));
+            }
+            print!("{}", gaitclip_host::gait_eval::table(&results));
         }
         Cmd::Eval {
             datasets,
