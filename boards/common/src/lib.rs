@@ -9,6 +9,8 @@
 //!   gaps.
 //! - [`startup`]: what the user is told while the core calibrates itself.
 //! - [`serial_line`]: the line protocol of the UART output.
+//! - [`rsc`]: the Bluetooth Running Speed and Cadence encodings and the foot pod's state, and
+//!   with the `ble` feature `rsc_gatt`, its GATT server on trouble-host.
 //! - [`replay_mpu6050`] and [`replay_holes`]: an MPU6050 on an emulated I²C bus serving a
 //!   stored trace, for the QEMU boards and the host tests.
 //! - On a Cortex-M only: `live_app` (the main loop of a board with a real sensor),
@@ -44,6 +46,9 @@ pub const DETECTOR: Detector = if cfg!(feature = "peak-valley-detector") {
 pub mod imu_sampler;
 pub mod replay_holes;
 pub mod replay_mpu6050;
+pub mod rsc;
+#[cfg(feature = "ble")]
+pub mod rsc_gatt;
 pub mod serial_line;
 pub mod startup;
 
