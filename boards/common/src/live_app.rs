@@ -19,6 +19,7 @@ use gaitclip::mpu6050::{self, Mpu6050};
 use gaitclip::pipeline::{Config, Pipeline};
 use gaitclip::rate::SampleRate;
 use gaitclip::sample::{AccelRange, GyroRange};
+use gaitclip::stride::Stride;
 use heapless::spsc::{Consumer, Producer, Queue};
 
 use crate::imu_sampler::{BusRecovery, Counters, ImuSampler, Item, ReadMode};
@@ -142,32 +143,16 @@ where
         log: &mut StrideLog,
         serial: &mut impl Write,
     ) -> ! {
-        let status_every_samples = config.rate.samples_in_ms(STATUS_EVERY_MS);
-        let mut startup = Startup::new(config.rate, config.gyro);
-        let mut samples = 0u32;
-        let mut next_status = status_every_samples;
+        let mut drain = Drain::new(config);
         loop {
-            while let Some(item) = consumer.dequeue() {
-                let stride = item.feed(pipeline);
-                if let Item::Sample(_) = item {
-                    samples = samples.wrapping_add(1);
-                    if let Some(e) = startup.update(pipeline) {
-                        log.startup(e, serial);
-                    }
-                }
-                // A stride a gap hands back was closed before it: it comes first.
-                if let Some(stride) = &stride {
-                    log.stride(stride, serial);
-                }
-                match item {
-                    Item::Sample(_) if samples == next_status => {
-                        next_status = next_status.wrapping_add(status_every_samples);
-                        log.summary(samples, &self.counters(), serial);
-                    }
-                    Item::Sample(_) => {}
-                    Item::Gap(n) => log.gap(n, pipeline.hole_kind(n), serial),
-                }
-            }
+            drain.run(
+                pipeline,
+                &mut consumer,
+                log,
+                serial,
+                || self.counters(),
+                |_| {},
+            );
             // Interrupts are masked while checking the queue so that a sample arriving between
             // the check and `wfi` still wakes the core (WFI wakes on a pending interrupt even
             // with PRIMASK set).
@@ -189,6 +174,69 @@ where
                 f(s, &mut |item| p.enqueue(item).is_ok());
             }
         });
+    }
+}
+
+/// The main loop's work on what the sampler queued: the pipeline, start-up reporting, the
+/// stride log, gaps and the periodic status line. A board with a blocking main loop runs it
+/// between `wfi`s ([`SampleLink::main_loop`]); the Bluetooth board from its pipeline task.
+pub struct Drain {
+    startup: Startup,
+    status_every_samples: u32,
+    samples: u32,
+    next_status: u32,
+}
+
+impl Drain {
+    /// Nothing processed yet, for a pipeline configured by `config`.
+    pub fn new(config: &Config) -> Self {
+        let status_every_samples = config.rate.samples_in_ms(STATUS_EVERY_MS);
+        Drain {
+            startup: Startup::new(config.rate, config.gyro),
+            status_every_samples,
+            samples: 0,
+            next_status: status_every_samples,
+        }
+    }
+
+    /// Samples processed so far.
+    pub const fn samples(&self) -> u32 {
+        self.samples
+    }
+
+    /// Feeds everything queued to the pipeline, logging as it goes; `on_stride` sees every
+    /// stride after the log (a gap's held stride first: it was closed before the gap).
+    /// `counters` gives the sampler's fault counters for the status line.
+    pub fn run<S: StepDetector>(
+        &mut self,
+        pipeline: &mut Pipeline<S>,
+        consumer: &mut Consumer<'_, Item>,
+        log: &mut StrideLog,
+        serial: &mut impl Write,
+        counters: impl Fn() -> Counters,
+        mut on_stride: impl FnMut(&Stride),
+    ) {
+        while let Some(item) = consumer.dequeue() {
+            let stride = item.feed(pipeline);
+            if let Item::Sample(_) = item {
+                self.samples = self.samples.wrapping_add(1);
+                if let Some(e) = self.startup.update(pipeline) {
+                    log.startup(e, serial);
+                }
+            }
+            if let Some(stride) = &stride {
+                log.stride(stride, serial);
+                on_stride(stride);
+            }
+            match item {
+                Item::Sample(_) if self.samples == self.next_status => {
+                    self.next_status = self.next_status.wrapping_add(self.status_every_samples);
+                    log.summary(self.samples, &counters(), serial);
+                }
+                Item::Sample(_) => {}
+                Item::Gap(n) => log.gap(n, pipeline.hole_kind(n), serial),
+            }
+        }
     }
 }
 
