@@ -10,6 +10,7 @@ set -euo pipefail
 root=$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)
 cd "$root"
 bash boards/install-qemu >&2
+bash boards/install-clang >&2
 command -v flip-link >/dev/null 2>&1 || cargo install --locked flip-link >&2
 
 datasets=$(cd "$root/.." && pwd)/shared/datasets

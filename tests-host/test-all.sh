@@ -1,13 +1,15 @@
 #!/usr/bin/env bash
 # Runs every check of gaitclip, as CI does: formatting and clippy (-D warnings) in every
 # workspace, the core's and the board glue's unit tests and docs on the host, release builds
-# of every board (QEMU mps2-an386 and micro:bit, nRF52840-DK, Raspberry Pi Pico) and of the
+# of every board (QEMU mps2-an386 and micro:bit, nRF52840-DK, its Bluetooth foot pod, Raspberry
+# Pi Pico) and of the
 # benchmark for both Cortex-M targets, and the host test suite (driver transactions, fixed
 # point vs f64, fixtures, MCAP/CSV readers and the MCAP conformance files, bus faults, gaps,
 # jitter and saturation, property tests, the fuzz corpus and regressions, real datasets when
 # ../shared/datasets is present, the bit-exact QEMU runs of the M4 and M0 firmware, and the instruction counts of
 # the cost benchmark). The cost figures themselves come from tests-host/cost.sh.
-# Installs what a fresh Debian machine lacks: qemu-system-arm (apt) and flip-link (cargo).
+# Installs what a fresh Debian machine lacks: qemu-system-arm, libclang and clang (apt) and
+# flip-link (cargo).
 # rustup installs the toolchain, targets and components named in rust-toolchain.toml; where
 # that toolchain is already installed without them, rustup does not add them on its own, so
 # the script asks it to (quick and idempotent when everything is there).
@@ -19,6 +21,8 @@ echo "== toolchain: $(grep '^channel' rust-toolchain.toml) with its targets and 
 rustup toolchain install
 
 bash "$root/boards/install-qemu"
+# The Bluetooth firmware's bindgen needs libclang and clang.
+bash "$root/boards/install-clang"
 # The boards link through flip-link (stack-overflow protection); cargo installs it.
 command -v flip-link >/dev/null 2>&1 || cargo install --locked flip-link
 

@@ -58,7 +58,7 @@ pub mod live_app;
 pub mod registers;
 #[cfg(all(target_os = "none", feature = "replay"))]
 pub mod replay_app;
-#[cfg(all(target_os = "none", feature = "replay"))]
+#[cfg(all(target_os = "none", feature = "paint-stack"))]
 pub mod stack_paint;
 #[cfg(target_os = "none")]
 pub mod stride_log;

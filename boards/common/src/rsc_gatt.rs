@@ -191,7 +191,8 @@ impl PodLink {
 
     /// Sets the battery level notified and read, %.
     pub fn set_battery_percent(&self, percent: u8) {
-        self.battery_percent.store(percent.min(100), Ordering::Relaxed);
+        self.battery_percent
+            .store(percent.min(100), Ordering::Relaxed);
     }
 
     /// (notifications sent, measurements not queued, connections).
@@ -228,7 +229,11 @@ pub async fn run<C: Controller>(controller: C, address: Address, link: &PodLink)
     let host = async {
         loop {
             if let Err(e) = runner.run().await {
-                ble_log!(error, "BLE host stopped: {}; restarting it", defmt::Debug2Format(&e));
+                ble_log!(
+                    error,
+                    "BLE host stopped: {}; restarting it",
+                    defmt::Debug2Format(&e)
+                );
                 let _ = e;
             }
         }
@@ -245,7 +250,11 @@ pub async fn run<C: Controller>(controller: C, address: Address, link: &PodLink)
                     ble_log!(info, "BLE: disconnected; advertising again");
                 }
                 Err(e) => {
-                    ble_log!(warn, "BLE: advertising failed ({}); retrying in 1 s", defmt::Debug2Format(&e));
+                    ble_log!(
+                        warn,
+                        "BLE: advertising failed ({}); retrying in 1 s",
+                        defmt::Debug2Format(&e)
+                    );
                     let _ = e;
                     Timer::after(Duration::from_secs(1)).await;
                 }
@@ -262,7 +271,12 @@ pub async fn run<C: Controller>(controller: C, address: Address, link: &PodLink)
 /// A setup error there is no way around (the table is a compile-time shape, so only a
 /// changed definition gets here): logged, then the panic handler.
 fn fail(what: &str, e: impl core::fmt::Debug) -> ! {
-    ble_log!(error, "BLE: {=str} failed: {}", what, defmt::Debug2Format(&e));
+    ble_log!(
+        error,
+        "BLE: {=str} failed: {}",
+        what,
+        defmt::Debug2Format(&e)
+    );
     panic!("BLE: {what} failed: {e:?}")
 }
 
@@ -327,7 +341,8 @@ async fn serve<P: PacketPool>(
                     }
                     GattEvent::Write(w) if w.handle() == rsc.control_point.handle => {
                         let answer = w.with_data(|_, d| {
-                            link.pod.lock(|p| p.borrow_mut().control_point(d, indications))
+                            link.pod
+                                .lock(|p| p.borrow_mut().control_point(d, indications))
                         });
                         match answer {
                             Ok(r) => {
@@ -346,7 +361,11 @@ async fn serve<P: PacketPool>(
                     let mut v = heapless::Vec::new();
                     let _ = v.extend_from_slice(&r);
                     if let Err(e) = rsc.control_point.indicate(conn, &v, false).await {
-                        ble_log!(warn, "BLE: control-point indication failed: {}", defmt::Debug2Format(&e));
+                        ble_log!(
+                            warn,
+                            "BLE: control-point indication failed: {}",
+                            defmt::Debug2Format(&e)
+                        );
                         let _ = e;
                     }
                     link.pod.lock(|p| p.borrow_mut().indication_done());
@@ -362,10 +381,15 @@ async fn serve<P: PacketPool>(
                     notify(rsc, conn, link, &m).await;
                 }
                 let level = link.battery_percent.load(Ordering::Relaxed);
-                if battery_sent != Some(level) {
-                    if server.battery.level.notify(conn, &level, true).await.is_ok() {
-                        battery_sent = Some(level);
-                    }
+                if battery_sent != Some(level)
+                    && server
+                        .battery
+                        .level
+                        .notify(conn, &level, true)
+                        .await
+                        .is_ok()
+                {
+                    battery_sent = Some(level);
                 }
             }
         }
