@@ -44,7 +44,8 @@ pub const FEATURE_TOTAL_DISTANCE: u16 = 1 << 1;
 /// RSC Feature bit: walking or running status.
 pub const FEATURE_WALKING_OR_RUNNING: u16 = 1 << 2;
 /// What gaitclip measures (no calibration procedure, one sensor location).
-pub const FEATURES: u16 = FEATURE_STRIDE_LENGTH | FEATURE_TOTAL_DISTANCE | FEATURE_WALKING_OR_RUNNING;
+pub const FEATURES: u16 =
+    FEATURE_STRIDE_LENGTH | FEATURE_TOTAL_DISTANCE | FEATURE_WALKING_OR_RUNNING;
 
 /// Measurement flag: stride length present.
 pub const FLAG_STRIDE_LENGTH: u8 = 1 << 0;
