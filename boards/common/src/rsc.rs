@@ -1,7 +1,7 @@
 //! The Bluetooth Running Speed and Cadence service (RSC, 0x1814) of a foot pod: what its
 //! characteristics carry, byte for byte, and the foot pod's state (total distance, the SC
 //! Control Point, when to say the wearer stands still). Pure `no_std`, no radio: the BLE
-//! firmware ([`crate::rsc_gatt`]) sends what these functions encode, and the host tests
+//! firmware (`rsc_gatt`, feature `ble`) sends what these functions encode, and the host tests
 //! check them against the layout of the Bluetooth SIG's *Running Speed and Cadence Service*
 //! 1.0 (§3.1–3.4) and against the field order of Nordic's decoder
 //! (`RunningSpeedAndCadenceMeasurementDataCallback` of the Android BLE library).
