@@ -479,7 +479,10 @@ fn render(r: &Report) -> String {
         r.gaitmap_rate,
         r.host_rate / r.gaitmap_rate
     );
-    let nrf = r.sizes.iter().find(|(l, _, _)| l.starts_with("nrf52840-dk"));
+    let nrf = r
+        .sizes
+        .iter()
+        .find(|(l, _, _)| l.starts_with("nrf52840-dk"));
     let _ = writeln!(o, "\n### Goals\n\n| goal | measured | |\n|---|---:|---|");
     let _ = writeln!(
         o,

@@ -31,15 +31,35 @@ fn gait_parameters_against_references() {
     // Times against the labelled events: heel-strike to heel-strike, 100 Hz labels.
     let e = errors(&ipol, "stride_time", None);
     assert!(e.len() > 1500, "{} ipol strides", e.len());
-    assert!(abs_quantile(&e, 0.5) <= 20.0, "ipol stride time {}", abs_quantile(&e, 0.5));
-    assert!(median(&e).abs() <= 10.0, "ipol stride time bias {}", median(&e));
+    assert!(
+        abs_quantile(&e, 0.5) <= 20.0,
+        "ipol stride time {}",
+        abs_quantile(&e, 0.5)
+    );
+    assert!(
+        median(&e).abs() <= 10.0,
+        "ipol stride time bias {}",
+        median(&e)
+    );
     let e = errors(&ipol, "swing_time", None);
-    assert!(abs_quantile(&e, 0.5) <= 40.0, "ipol swing {}", abs_quantile(&e, 0.5));
+    assert!(
+        abs_quantile(&e, 0.5) <= 40.0,
+        "ipol swing {}",
+        abs_quantile(&e, 0.5)
+    );
     let e = errors(&ipol, "cadence", None);
-    assert!(abs_quantile(&e, 0.5) <= 3.0, "ipol cadence {}", abs_quantile(&e, 0.5));
+    assert!(
+        abs_quantile(&e, 0.5) <= 3.0,
+        "ipol cadence {}",
+        abs_quantile(&e, 0.5)
+    );
     let e = errors(&gaitmap, "stride_time", None);
     assert!(e.len() >= 40);
-    assert!(abs_quantile(&e, 0.5) <= 30.0, "gaitmap stride time {}", abs_quantile(&e, 0.5));
+    assert!(
+        abs_quantile(&e, 0.5) <= 30.0,
+        "gaitmap stride time {}",
+        abs_quantile(&e, 0.5)
+    );
 
     // Velocity against Vicon, by pace.
     for (pace, bound) in [("walking", 0.03), ("fast", 0.05)] {
@@ -58,15 +78,27 @@ fn gait_parameters_against_references() {
         .filter(|c| c.parameter == "max_sensor_lift")
         .map(|c| c.ours)
         .collect();
-    assert!((50.0..250.0).contains(&median(&lift)), "lift {}", median(&lift));
+    assert!(
+        (50.0..250.0).contains(&median(&lift)),
+        "lift {}",
+        median(&lift)
+    );
 
     // Turning: one U-turn per walk; straight strides do not turn.
     let turns: Vec<f64> = gaitmap.trial_turns.iter().map(|t| t.1 - 180.0).collect();
     assert!(turns.iter().all(|e| e.abs() < 10.0), "{turns:?}");
     let turns: Vec<f64> = ipol.trial_turns.iter().map(|t| t.1 - 180.0).collect();
-    assert!(abs_quantile(&turns, 0.5) < 15.0, "ipol U-turns {}", abs_quantile(&turns, 0.5));
+    assert!(
+        abs_quantile(&turns, 0.5) < 15.0,
+        "ipol U-turns {}",
+        abs_quantile(&turns, 0.5)
+    );
     let e = errors(&ipol, "turning_angle (straight)", None);
-    assert!(abs_quantile(&e, 0.5) < 3.0, "straight strides turn {}", abs_quantile(&e, 0.5));
+    assert!(
+        abs_quantile(&e, 0.5) < 3.0,
+        "straight strides turn {}",
+        abs_quantile(&e, 0.5)
+    );
 
     // Walking strides are called walking.
     let n = |class, gait| pyshoe.status.get(&(class, gait)).copied().unwrap_or(0);
@@ -80,7 +112,13 @@ fn gait_parameters_against_references() {
         ("ipol_gait_events".into(), ipol),
         ("pyshoe_vicon".into(), pyshoe),
     ]);
-    for p in ["stride_time", "max_sensor_lift", "gait_velocity", "U-turn", "> 2.5 m/s"] {
+    for p in [
+        "stride_time",
+        "max_sensor_lift",
+        "gait_velocity",
+        "U-turn",
+        "> 2.5 m/s",
+    ] {
         assert!(t.contains(p), "{p} missing from\n{t}");
     }
 }

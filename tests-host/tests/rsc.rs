@@ -31,7 +31,8 @@ fn nordic_decode(d: &[u8]) -> Option<Decoded> {
         offset += 2;
         u16::from_le_bytes([d[offset - 2], d[offset - 1]])
     });
-    let total = total_present.then(|| u32::from_le_bytes(d[offset..offset + 4].try_into().unwrap()));
+    let total =
+        total_present.then(|| u32::from_le_bytes(d[offset..offset + 4].try_into().unwrap()));
     Some((running, speed, cadence, stride, total))
 }
 
@@ -53,7 +54,10 @@ fn measurement_matches_nordics_test_vector() {
         running: true,
     };
     let bytes = encode(&m);
-    assert_eq!(bytes, [0x07, 0x00, 0x03, 18, 86, 0x00, 0x01, 0x00, 0x00, 0xF0]);
+    assert_eq!(
+        bytes,
+        [0x07, 0x00, 0x03, 18, 86, 0x00, 0x01, 0x00, 0x00, 0xF0]
+    );
     assert_eq!(
         nordic_decode(&bytes),
         Some((true, 3.0, 18, Some(86), Some(0xF000_0001)))
@@ -163,7 +167,10 @@ fn control_point_state_machine() {
         pod.control_point(&[0x01, 0x10, 0x27, 0, 0], false),
         Err(ControlPointRefusal::CccdImproperlyConfigured)
     );
-    assert_eq!(ControlPointRefusal::CccdImproperlyConfigured.att_error(), 0x81);
+    assert_eq!(
+        ControlPointRefusal::CccdImproperlyConfigured.att_error(),
+        0x81
+    );
     assert_eq!(pod.total_distance_dm(), 14);
     // Set Cumulative Value: 10 000 dm = 1 km.
     assert_eq!(
@@ -176,7 +183,10 @@ fn control_point_state_machine() {
         pod.control_point(&[0x01, 0, 0, 0, 0], true),
         Err(ControlPointRefusal::ProcedureAlreadyInProgress)
     );
-    assert_eq!(ControlPointRefusal::ProcedureAlreadyInProgress.att_error(), 0x80);
+    assert_eq!(
+        ControlPointRefusal::ProcedureAlreadyInProgress.att_error(),
+        0x80
+    );
     pod.indication_done();
     // The total goes on from the value set.
     pod.stride(&stride(1400, Gait::Walking, 0), 1100);
@@ -191,7 +201,11 @@ fn control_point_state_machine() {
         assert_eq!(pod.control_point(bad, true), Ok([0x10, 0x01, 0x03]));
         pod.indication_done();
     }
-    assert_eq!(pod.total_distance_dm(), 10_014, "invalid writes change nothing");
+    assert_eq!(
+        pod.total_distance_dm(),
+        10_014,
+        "invalid writes change nothing"
+    );
     assert_eq!(
         pod.control_point(&[], true),
         Err(ControlPointRefusal::Empty)

@@ -59,13 +59,19 @@ fn gatt_table_reads_back() {
         .map(|a| a.2.clone())
         .collect();
     for s in [rsc::SERVICE_UUID, 0x180F, 0x180A] {
-        assert!(services.contains(&s.to_le_bytes().to_vec()), "service {s:#06x}");
+        assert!(
+            services.contains(&s.to_le_bytes().to_vec()),
+            "service {s:#06x}"
+        );
     }
 
     // RSC Measurement: notify only, with its CCCD.
     let (props, h) = declaration_of(&attrs, rsc::MEASUREMENT_UUID);
     assert_eq!(props, NOTIFY);
-    assert_eq!(attrs.iter().find(|a| a.0 == h + 1).unwrap().1, u16_uuid(0x2902));
+    assert_eq!(
+        attrs.iter().find(|a| a.0 == h + 1).unwrap().1,
+        u16_uuid(0x2902)
+    );
     // RSC Feature: read, stride length + total distance + walking/running.
     let (props, h) = declaration_of(&attrs, rsc::FEATURE_UUID);
     assert_eq!(props, READ);
@@ -77,7 +83,10 @@ fn gatt_table_reads_back() {
     // SC Control Point: write and indicate, with a CCCD.
     let (props, h) = declaration_of(&attrs, rsc::CONTROL_POINT_UUID);
     assert_eq!(props, WRITE | INDICATE);
-    assert_eq!(attrs.iter().find(|a| a.0 == h + 1).unwrap().1, u16_uuid(0x2902));
+    assert_eq!(
+        attrs.iter().find(|a| a.0 == h + 1).unwrap().1,
+        u16_uuid(0x2902)
+    );
     assert_eq!(
         server.rsc.control_point.cccd_handle().map(|c| c.handle()),
         Some(h + 1)
@@ -140,7 +149,10 @@ fn strides_count_without_a_central() {
         link.stride(&s, i * 1100);
     }
     assert_eq!(link.total_distance_dm(), 140);
-    assert_eq!(link.counters(), (0, 10 - rsc_gatt::QUEUED_MEASUREMENTS as u32, 0));
+    assert_eq!(
+        link.counters(),
+        (0, 10 - rsc_gatt::QUEUED_MEASUREMENTS as u32, 0)
+    );
 }
 
 #[test]
