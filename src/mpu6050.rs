@@ -2,7 +2,9 @@
 //!
 //! Covers what gaitclip needs from the part: probing `WHO_AM_I`, reset and configuration for a
 //! requested output rate, one-burst sample reads, the data-ready interrupt and the FIFO with
-//! overflow detection. Every register access is a single `write` or `write_read`, so a bus
+//! overflow detection, and the low-power wait for the first step: the accelerometer alone
+//! in cycle mode with the motion interrupt ([`Mpu6050::enter_motion_wake`],
+//! [`Mpu6050::leave_motion_wake`]). Every register access is a single `write` or `write_read`, so a bus
 //! error surfaces as [`Error::Bus`] and the caller decides whether to retry.
 //!
 //! ```no_run
@@ -43,8 +45,14 @@ pub mod reg {
     pub const ACCEL_XOUT_H: u8 = 0x3B;
     /// FIFO / I2C master / signal-path control.
     pub const USER_CTRL: u8 = 0x6A;
-    /// Power management 1: reset, sleep, clock source.
+    /// Power management 1: reset, sleep, cycle, temperature disable, clock source.
     pub const PWR_MGMT_1: u8 = 0x6B;
+    /// Power management 2: LP_WAKE_CTRL in bits 7:6, per-axis standby in bits 5:0.
+    pub const PWR_MGMT_2: u8 = 0x6C;
+    /// Motion detection threshold (one count is 2 or 32 mg: [`super::MotionThresholdUnit`]).
+    pub const MOT_THR: u8 = 0x1F;
+    /// Motion detection duration, 1 ms per count at the 1 kHz accelerometer rate.
+    pub const MOT_DUR: u8 = 0x20;
     /// FIFO byte count, high byte first.
     pub const FIFO_COUNT_H: u8 = 0x72;
     /// FIFO read port.
@@ -71,6 +79,18 @@ pub mod bits {
     pub const DATA_RDY: u8 = 0x01;
     /// INT_ENABLE / INT_STATUS: FIFO overflow.
     pub const FIFO_OFLOW: u8 = 0x10;
+    /// INT_ENABLE / INT_STATUS: motion detected (bit 6).
+    pub const MOT: u8 = 0x40;
+    /// PWR_MGMT_1: cycle between sleep and one accelerometer sample at LP_WAKE_CTRL's rate.
+    pub const CYCLE: u8 = 0x20;
+    /// PWR_MGMT_1: temperature sensor off.
+    pub const TEMP_DIS: u8 = 0x08;
+    /// PWR_MGMT_2: the three gyro axes in standby.
+    pub const STBY_GYRO: u8 = 0x04 | 0x02 | 0x01;
+    /// ACCEL_CONFIG bits 2:0, ACCEL_HPF = 1: the 5 Hz high-pass filter the motion detector
+    /// compares against its threshold (register map rev 3.x; rev 4.2 marks the bits reserved,
+    /// and the part still needs a high-pass setting for motion detection to fire).
+    pub const ACCEL_HPF_5HZ: u8 = 0x01;
 }
 
 /// The value `WHO_AM_I` reads on an MPU6050, whatever the AD0 pin.
@@ -100,6 +120,119 @@ impl Address {
     }
 }
 
+/// Accelerometer wake-up rate in the low-power cycle mode (PWR_MGMT_2 LP_WAKE_CTRL), with the
+/// supply current the datasheet gives for it (PS-MPU-6000A-00 rev 3.4, §6.3, "Accelerometer
+/// Low Power Mode Current").
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum WakeRate {
+    /// 1.25 Hz, 10 µA.
+    Hz1_25,
+    /// 5 Hz, 20 µA.
+    Hz5,
+    /// 20 Hz, 70 µA.
+    Hz20,
+    /// 40 Hz, 140 µA.
+    Hz40,
+}
+
+impl WakeRate {
+    /// LP_WAKE_CTRL.
+    pub const fn lp_wake_ctrl(self) -> u8 {
+        match self {
+            WakeRate::Hz1_25 => 0,
+            WakeRate::Hz5 => 1,
+            WakeRate::Hz20 => 2,
+            WakeRate::Hz40 => 3,
+        }
+    }
+
+    /// The rate, mHz.
+    pub const fn millihertz(self) -> u32 {
+        match self {
+            WakeRate::Hz1_25 => 1250,
+            WakeRate::Hz5 => 5000,
+            WakeRate::Hz20 => 20_000,
+            WakeRate::Hz40 => 40_000,
+        }
+    }
+
+    /// Typical supply current in this mode, µA (datasheet §6.3).
+    pub const fn supply_ua(self) -> u32 {
+        match self {
+            WakeRate::Hz1_25 => 10,
+            WakeRate::Hz5 => 20,
+            WakeRate::Hz20 => 70,
+            WakeRate::Hz40 => 140,
+        }
+    }
+}
+
+/// What one MOT_THR count is worth. The documents disagree: the product specification
+/// (PS-MPU-6000A-00 rev 3.4, §6.2, "Intelligence function increment") says 32 mg per LSB,
+/// a register-map revision 2 mg. A board says which its parts follow (the threshold is
+/// configured in mg, never as a bare count), and [`Mpu6050::enter_motion_wake`] reads the
+/// register back.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum MotionThresholdUnit {
+    /// 2 mg per count (register map rev 4.2).
+    Mg2,
+    /// 32 mg per count (product specification rev 3.4).
+    Mg32,
+}
+
+impl MotionThresholdUnit {
+    /// mg per count.
+    pub const fn mg_per_count(self) -> u32 {
+        match self {
+            MotionThresholdUnit::Mg2 => 2,
+            MotionThresholdUnit::Mg32 => 32,
+        }
+    }
+}
+
+/// A motion-detection threshold: the MOT_THR count for a high-passed acceleration in mg.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct MotionThreshold {
+    counts: u8,
+}
+
+impl MotionThreshold {
+    /// The nearest count to `mg` in `unit` (at least 1): `None` when it does not fit the
+    /// register (1..=255 counts: 2–510 mg or 32–8 160 mg) or `mg` is 0.
+    pub const fn from_mg(mg: u32, unit: MotionThresholdUnit) -> Option<Self> {
+        let per = unit.mg_per_count();
+        let counts = (mg + per / 2) / per;
+        if mg == 0 || counts == 0 || counts > 255 {
+            None
+        } else {
+            Some(MotionThreshold {
+                counts: counts as u8,
+            })
+        }
+    }
+
+    /// The register value.
+    pub const fn counts(self) -> u8 {
+        self.counts
+    }
+
+    /// The threshold in mg, in `unit`.
+    pub const fn mg(self, unit: MotionThresholdUnit) -> u32 {
+        self.counts as u32 * unit.mg_per_count()
+    }
+}
+
+/// The low-power wait for motion.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct MotionWake {
+    /// How often the accelerometer wakes to sample.
+    pub rate: WakeRate,
+    /// The high-passed acceleration that counts as motion.
+    pub threshold: MotionThreshold,
+    /// How long it must last, ms (MOT_DUR; counted at the accelerometer's 1 kHz).
+    pub duration_ms: u8,
+}
+
 /// Driver errors.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Error<E> {
@@ -112,6 +245,8 @@ pub enum Error<E> {
     FifoOverflow,
     /// The FIFO count is not a whole number of samples: the FIFO was reset.
     FifoMisaligned(u16),
+    /// A register read back other than what was written (register, written, read).
+    Verify(u8, u8, u8),
 }
 
 impl<E> From<E> for Error<E> {
@@ -205,6 +340,10 @@ impl InterruptStatus {
     /// The FIFO overflowed since the last read.
     pub const fn fifo_overflow(self) -> bool {
         self.0 & bits::FIFO_OFLOW != 0
+    }
+    /// Motion was detected (the low-power wake).
+    pub const fn motion(self) -> bool {
+        self.0 & bits::MOT != 0
     }
 }
 
@@ -328,6 +467,54 @@ impl<I: I2c> Mpu6050<I> {
             *slot = RawSample::from_be_bytes(&buf);
         }
         Ok(n)
+    }
+
+    /// Waits for the first step at a few µA: stops the data-ready interrupt and the FIFO, sets
+    /// the accelerometer's 5 Hz high-pass filter (what the motion detector compares) and the
+    /// threshold (read back: [`Error::Verify`] if the part did not take it) and duration,
+    /// latches INT on motion (a level the MCU cannot miss while it sleeps), puts the gyro in
+    /// standby and the temperature sensor off, and cycles the accelerometer at `wake.rate`
+    /// on the internal oscillator (the gyro's PLL is off). `accel` is the range kept.
+    pub fn enter_motion_wake(
+        &mut self,
+        wake: &MotionWake,
+        accel: AccelRange,
+    ) -> Result<(), Error<I::Error>> {
+        self.write_reg(reg::INT_ENABLE, 0)?;
+        self.write_reg(reg::USER_CTRL, 0)?;
+        self.write_reg(reg::FIFO_EN, 0)?;
+        self.write_reg(
+            reg::ACCEL_CONFIG,
+            accel.afs_sel() << 3 | bits::ACCEL_HPF_5HZ,
+        )?;
+        let counts = wake.threshold.counts();
+        self.write_reg(reg::MOT_THR, counts)?;
+        let read = self.read_reg(reg::MOT_THR)?;
+        if read != counts {
+            return Err(Error::Verify(reg::MOT_THR, counts, read));
+        }
+        self.write_reg(reg::MOT_DUR, wake.duration_ms)?;
+        self.write_reg(reg::INT_PIN_CFG, bits::INT_LATCH_ANY_READ_CLEAR)?;
+        self.write_reg(reg::INT_ENABLE, bits::MOT)?;
+        self.write_reg(
+            reg::PWR_MGMT_2,
+            wake.rate.lp_wake_ctrl() << 6 | bits::STBY_GYRO,
+        )?;
+        self.write_reg(reg::PWR_MGMT_1, bits::CYCLE | bits::TEMP_DIS)
+    }
+
+    /// Back from [`Mpu6050::enter_motion_wake`] to full 6-axis sampling with `config`'s
+    /// ranges: the gyro's PLL clock and the temperature sensor on, cycle off, every axis out
+    /// of standby, the high-pass filter off, the motion interrupt off and its latch cleared.
+    /// The caller then enables its interrupt and FIFO again, as after [`Mpu6050::init`]; the
+    /// gyro needs its start-up time (datasheet §6.1: 30 ms) before its samples settle.
+    pub fn leave_motion_wake(&mut self, config: &Config) -> Result<(), Error<I::Error>> {
+        self.write_reg(reg::PWR_MGMT_1, bits::CLKSEL_PLL_XGYRO)?;
+        self.write_reg(reg::PWR_MGMT_2, 0)?;
+        self.write_reg(reg::ACCEL_CONFIG, config.accel.afs_sel() << 3)?;
+        self.write_reg(reg::INT_ENABLE, 0)?;
+        self.read_interrupt_status()?;
+        Ok(())
     }
 
     fn reset_fifo(&mut self) -> Result<(), Error<I::Error>> {

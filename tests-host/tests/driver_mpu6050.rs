@@ -4,7 +4,10 @@
 use embedded_hal::i2c::ErrorKind;
 use embedded_hal_mock::eh1::delay::NoopDelay;
 use embedded_hal_mock::eh1::i2c::{Mock, Transaction as T};
-use gaitclip::mpu6050::{Address, Config, Error, Mpu6050, OutputRate};
+use gaitclip::mpu6050::{
+    Address, Config, Error, MotionThreshold, MotionThresholdUnit, MotionWake, Mpu6050, OutputRate,
+    WakeRate,
+};
 use gaitclip::sample::{AccelRange, GyroRange, RawSample};
 
 const ADDR: u8 = 0x68;
@@ -226,4 +229,110 @@ fn bus_error_during_read_surfaces_as_bus() {
     let mut imu = Mpu6050::new(bus.clone(), Address::Ad0Low);
     assert_eq!(imu.read_sample().unwrap_err(), Error::Bus(ErrorKind::Other));
     bus.done();
+}
+
+const MOT_THR: u8 = 0x1F;
+const MOT_DUR: u8 = 0x20;
+const PWR_MGMT_2: u8 = 0x6C;
+
+fn motion_wake(mg: u32, unit: MotionThresholdUnit) -> MotionWake {
+    MotionWake {
+        rate: WakeRate::Hz5,
+        threshold: MotionThreshold::from_mg(mg, unit).unwrap(),
+        duration_ms: 2,
+    }
+}
+
+/// Cycle mode with the motion interrupt, register by register (register map rev 4.2 and the
+/// product specification rev 3.4): data-ready and FIFO off, ACCEL_CONFIG = ±16 g (3 << 3)
+/// with ACCEL_HPF = 1 (5 Hz), MOT_THR written and read back, MOT_DUR, INT latched until
+/// read (0x30), INT_ENABLE = MOT_EN (bit 6), PWR_MGMT_2 = LP_WAKE_CTRL 1 (5 Hz) in bits 7:6
+/// with STBY_XG/YG/ZG (bits 2:0), PWR_MGMT_1 = CYCLE (bit 5) | TEMP_DIS (bit 3), CLKSEL 0.
+#[test]
+fn enter_motion_wake_transactions() {
+    let wake = motion_wake(64, MotionThresholdUnit::Mg32);
+    assert_eq!(wake.threshold.counts(), 2);
+    let mut bus = Mock::new(&[
+        T::write(ADDR, vec![INT_ENABLE, 0x00]),
+        T::write(ADDR, vec![USER_CTRL, 0x00]),
+        T::write(ADDR, vec![FIFO_EN, 0x00]),
+        T::write(ADDR, vec![ACCEL_CONFIG, 0x18 | 0x01]),
+        T::write(ADDR, vec![MOT_THR, 2]),
+        T::write_read(ADDR, vec![MOT_THR], vec![2]),
+        T::write(ADDR, vec![MOT_DUR, 2]),
+        T::write(ADDR, vec![INT_PIN_CFG, 0x30]),
+        T::write(ADDR, vec![INT_ENABLE, 0x40]),
+        T::write(ADDR, vec![PWR_MGMT_2, 0x40 | 0x07]),
+        T::write(ADDR, vec![PWR_MGMT_1, 0x20 | 0x08]),
+    ]);
+    let mut imu = Mpu6050::new(bus.clone(), Address::Ad0Low);
+    imu.enter_motion_wake(&wake, AccelRange::G16).unwrap();
+    bus.done();
+}
+
+/// A part that does not keep MOT_THR is reported, not trusted to wake the clip.
+#[test]
+fn motion_threshold_is_read_back() {
+    let wake = motion_wake(100, MotionThresholdUnit::Mg2);
+    assert_eq!(wake.threshold.counts(), 50);
+    let mut bus = Mock::new(&[
+        T::write(ADDR, vec![INT_ENABLE, 0x00]),
+        T::write(ADDR, vec![USER_CTRL, 0x00]),
+        T::write(ADDR, vec![FIFO_EN, 0x00]),
+        T::write(ADDR, vec![ACCEL_CONFIG, 0x10 | 0x01]),
+        T::write(ADDR, vec![MOT_THR, 50]),
+        T::write_read(ADDR, vec![MOT_THR], vec![0]),
+    ]);
+    let mut imu = Mpu6050::new(bus.clone(), Address::Ad0Low);
+    assert_eq!(
+        imu.enter_motion_wake(&wake, AccelRange::G8),
+        Err(Error::Verify(MOT_THR, 50, 0))
+    );
+    bus.done();
+}
+
+/// Back to 6-axis sampling: PLL clock, cycle and TEMP_DIS off (PWR_MGMT_1 = 0x01), no
+/// standby, the high-pass filter off, the motion interrupt off and its latch read clear.
+#[test]
+fn leave_motion_wake_transactions() {
+    let mut bus = Mock::new(&[
+        T::write(ADDR, vec![PWR_MGMT_1, 0x01]),
+        T::write(ADDR, vec![PWR_MGMT_2, 0x00]),
+        T::write(ADDR, vec![ACCEL_CONFIG, 0x18]),
+        T::write(ADDR, vec![INT_ENABLE, 0x00]),
+        T::write_read(ADDR, vec![INT_STATUS], vec![0x40]),
+    ]);
+    let mut imu = Mpu6050::new(bus.clone(), Address::Ad0Low);
+    imu.leave_motion_wake(&Config::new(OutputRate::from_hz(200).unwrap()))
+        .unwrap();
+    bus.done();
+}
+
+#[test]
+fn wake_rates_and_thresholds() {
+    // (rate, LP_WAKE_CTRL, mHz, µA of PS rev 3.4 §6.3)
+    for (r, ctrl, mhz, ua) in [
+        (WakeRate::Hz1_25, 0, 1250, 10),
+        (WakeRate::Hz5, 1, 5000, 20),
+        (WakeRate::Hz20, 2, 20_000, 70),
+        (WakeRate::Hz40, 3, 40_000, 140),
+    ] {
+        assert_eq!(
+            (r.lp_wake_ctrl(), r.millihertz(), r.supply_ua()),
+            (ctrl, mhz, ua)
+        );
+    }
+    use MotionThresholdUnit::{Mg2, Mg32};
+    assert_eq!(MotionThreshold::from_mg(0, Mg2), None);
+    assert_eq!(
+        MotionThreshold::from_mg(1, Mg32),
+        None,
+        "rounds to 0 counts"
+    );
+    assert_eq!(MotionThreshold::from_mg(510, Mg2).unwrap().counts(), 255);
+    assert_eq!(MotionThreshold::from_mg(512, Mg2), None, "over 255 counts");
+    assert_eq!(MotionThreshold::from_mg(8160, Mg32).unwrap().counts(), 255);
+    // The same count is 16 times more acceleration in the other unit.
+    let t = MotionThreshold::from_mg(96, Mg32).unwrap();
+    assert_eq!((t.counts(), t.mg(Mg32), t.mg(Mg2)), (3, 96, 6));
 }
