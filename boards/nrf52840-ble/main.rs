@@ -43,13 +43,12 @@ use embassy_sync::blocking_mutex::raw::CriticalSectionRawMutex;
 use embassy_sync::blocking_mutex::Mutex;
 use embassy_sync::signal::Signal;
 use embassy_time::{Duration, Instant, Ticker, Timer};
-use gaitclip::mpu6050::{self, Address, Mpu6050};
-use gaitclip::pipeline::{Config, Pipeline};
-use gaitclip::rate::SampleRate;
-use gaitclip::sample::{AccelRange, GyroRange};
+use gaitclip::mpu6050::{Address, Mpu6050};
+use gaitclip::pipeline::Pipeline;
 use gaitclip::stride::MAX_MOVEMENT_SAMPLES;
 use gaitclip_board::imu_sampler::{BusRecovery, Counters, ImuSampler, Item, ReadMode};
 use gaitclip_board::live_app::{self, Drain, SpinDelay, Watchdog, WATCHDOG_TICK_MS};
+use gaitclip_board::live_settings::{CONFIG, FIFO_BATCH, QUEUE_LEN, RATE, SENSOR};
 use gaitclip_board::rsc_gatt::{self, battery_percent, PodLink};
 use gaitclip_board::stride_log::StrideLog;
 use gaitclip_board::{serial_line, stack_paint, Steps};
@@ -60,19 +59,8 @@ use panic_probe as _;
 use static_cell::{ConstStaticCell, StaticCell};
 use trouble_host::prelude::{Address as BleAddress, DefaultPacketPool, PacketPool};
 
-/// Output data rate of the sensor.
-const RATE_HZ: u16 = 200;
-/// Data-ready pulses per FIFO burst: 8 samples (40 ms) per I2C transaction at 200 Hz.
-const FIFO_BATCH: u8 = 8;
-/// Queue between the sampler and the pipeline task: 0.64 s at 200 Hz.
-const QUEUE_LEN: usize = 128;
-const ACCEL: AccelRange = AccelRange::G16;
-const GYRO: GyroRange = GyroRange::Dps2000;
 /// The core clock, 64 MHz.
 const CYCLES_PER_US: u32 = 64;
-const RATE: SampleRate = live_app::sample_rate(RATE_HZ);
-const SENSOR: mpu6050::Config = live_app::sensor_config(RATE_HZ, ACCEL, GYRO);
-const CONFIG: Config = live_app::config(RATE, ACCEL, GYRO);
 /// Interval of the supply measurement for the Battery Service.
 const BATTERY_EVERY_S: u64 = 60;
 /// The SoftDevice Controller's memory for one peripheral link with trouble's buffers
@@ -102,15 +90,8 @@ static PIPELINE: ConstStaticCell<Pipeline<Steps<MAX_MOVEMENT_SAMPLES>>> =
 /// Raised by the sampler after every data-ready pulse it handled.
 static QUEUED: Signal<CriticalSectionRawMutex, ()> = Signal::new();
 /// The sampler's fault counters, for the status line.
-static COUNTERS: Mutex<CriticalSectionRawMutex, Cell<Counters>> = Mutex::new(Cell::new(Counters {
-    bus_errors: 0,
-    restarts: 0,
-    recoveries: 0,
-    fifo_overflows: 0,
-    silences: 0,
-    overruns: 0,
-    lost_samples: 0,
-}));
+static COUNTERS: Mutex<CriticalSectionRawMutex, Cell<Counters>> =
+    Mutex::new(Cell::new(Counters::ZERO));
 /// The foot pod, between the pipeline task and the Bluetooth task.
 static POD: PodLink = PodLink::new();
 

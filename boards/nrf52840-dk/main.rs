@@ -25,10 +25,8 @@ use cortex_m::interrupt::{self as irq, Mutex};
 use cortex_m_rt::entry;
 use defmt_rtt as _;
 use embedded_hal::i2c::{ErrorType, I2c, Operation, SevenBitAddress};
-use gaitclip::mpu6050::{self, Address, Mpu6050};
-use gaitclip::pipeline::{Config, Pipeline};
-use gaitclip::rate::SampleRate;
-use gaitclip::sample::{AccelRange, GyroRange};
+use gaitclip::mpu6050::{Address, Mpu6050};
+use gaitclip::pipeline::Pipeline;
 use gaitclip::stride::MAX_MOVEMENT_SAMPLES;
 use heapless::spsc::Queue;
 use nrf52840_hal::{
@@ -43,22 +41,13 @@ use nrf52840_hal::{
 use panic_probe as _;
 use static_cell::ConstStaticCell;
 
+use gaitclip_board::live_settings::{CONFIG, FIFO_BATCH, QUEUE_LEN, RATE, SENSOR};
 use imu_sampler::{BusRecovery, Item, ReadMode};
 use live_app::{SampleLink, SpinDelay, Watchdog, WATCHDOG_TICK_MS};
 use stride_log::StrideLog;
 
-/// Output data rate of the sensor.
-const RATE_HZ: u16 = 200;
-/// Data-ready pulses per FIFO burst: 8 samples (40 ms) per I2C transaction at 200 Hz.
-const FIFO_BATCH: u8 = 8;
-/// Queue between the INT handler and the main loop: 0.64 s at 200 Hz.
-const QUEUE_LEN: usize = 128;
-const ACCEL: AccelRange = AccelRange::G16;
-const GYRO: GyroRange = GyroRange::Dps2000;
 /// The core clock, 64 MHz.
 const CYCLES_PER_US: u32 = 64;
-const RATE: SampleRate = live_app::sample_rate(RATE_HZ);
-const SENSOR: mpu6050::Config = live_app::sensor_config(RATE_HZ, ACCEL, GYRO);
 
 /// TWIM0 that can give its pins back to clock a stuck bus free.
 struct RecoverableTwim {
@@ -112,7 +101,6 @@ type WatchdogTimer = Timer<TIMER1, Periodic>;
 static WATCHDOG: Mutex<RefCell<Option<(WatchdogTimer, Watchdog)>>> = Mutex::new(RefCell::new(None));
 static QUEUE: ConstStaticCell<Queue<Item, QUEUE_LEN>> = ConstStaticCell::new(Queue::new());
 /// The pipeline's configuration.
-const CONFIG: Config = live_app::config(RATE, ACCEL, GYRO);
 static PIPELINE: ConstStaticCell<Pipeline<Steps<MAX_MOVEMENT_SAMPLES>>> =
     ConstStaticCell::new(Pipeline::with_detector(CONFIG, Steps::new(&CONFIG)));
 
@@ -136,11 +124,7 @@ fn main() -> ! {
         uarte::Baudrate::BAUD115200,
     );
     let mut log = StrideLog::new(RATE);
-    log.banner(
-        "nrf52840-dk",
-        &live_app::config(RATE, ACCEL, GYRO),
-        &mut serial,
-    );
+    log.banner("nrf52840-dk", &CONFIG, &mut serial);
 
     let bus = RecoverableTwim {
         twim: Some(Twim::new(

@@ -23,10 +23,8 @@ use cortex_m::interrupt::{self as irq, Mutex};
 use defmt_rtt as _;
 use embedded_hal::i2c::{ErrorType, I2c, Operation, SevenBitAddress};
 use fugit::{HertzU32, RateExtU32};
-use gaitclip::mpu6050::{self, Address, Mpu6050};
-use gaitclip::pipeline::{Config, Pipeline};
-use gaitclip::rate::SampleRate;
-use gaitclip::sample::{AccelRange, GyroRange};
+use gaitclip::mpu6050::{Address, Mpu6050};
+use gaitclip::pipeline::Pipeline;
 use gaitclip::stride::MAX_MOVEMENT_SAMPLES;
 use heapless::spsc::Queue;
 use panic_probe as _;
@@ -45,6 +43,7 @@ use rp2040_hal::{
 };
 use static_cell::ConstStaticCell;
 
+use gaitclip_board::live_settings::{CONFIG, FIFO_BATCH, QUEUE_LEN, RATE, SENSOR};
 use imu_sampler::{BusRecovery, Item, ReadMode};
 use live_app::{SampleLink, SpinDelay, Watchdog as SensorWatchdog, WATCHDOG_TICK_MS};
 use stride_log::StrideLog;
@@ -56,18 +55,8 @@ pub static BOOT2: [u8; 256] = rp2040_boot2::BOOT_LOADER_W25Q080;
 
 /// The Pico's crystal.
 const XOSC_HZ: u32 = 12_000_000;
-/// Output data rate of the sensor.
-const RATE_HZ: u16 = 200;
-/// Data-ready pulses per FIFO burst: 8 samples (40 ms) per I2C transaction at 200 Hz.
-const FIFO_BATCH: u8 = 8;
-/// Queue between the INT handler and the main loop: 0.64 s at 200 Hz.
-const QUEUE_LEN: usize = 128;
-const ACCEL: AccelRange = AccelRange::G16;
-const GYRO: GyroRange = GyroRange::Dps2000;
 /// The system clock, 125 MHz.
 const CYCLES_PER_US: u32 = 125;
-const RATE: SampleRate = live_app::sample_rate(RATE_HZ);
-const SENSOR: mpu6050::Config = live_app::sensor_config(RATE_HZ, ACCEL, GYRO);
 
 type Sda = Pin<Gpio4, FunctionI2C, PullUp>;
 type Scl = Pin<Gpio5, FunctionI2C, PullUp>;
@@ -126,7 +115,6 @@ static INT_PIN: Mutex<RefCell<Option<IntPin>>> = Mutex::new(RefCell::new(None));
 static WATCHDOG: Mutex<RefCell<Option<(Alarm0, SensorWatchdog)>>> = Mutex::new(RefCell::new(None));
 static QUEUE: ConstStaticCell<Queue<Item, QUEUE_LEN>> = ConstStaticCell::new(Queue::new());
 /// The pipeline's configuration.
-const CONFIG: Config = live_app::config(RATE, ACCEL, GYRO);
 static PIPELINE: ConstStaticCell<Pipeline<Steps<MAX_MOVEMENT_SAMPLES>>> =
     ConstStaticCell::new(Pipeline::with_detector(CONFIG, Steps::new(&CONFIG)));
 
@@ -166,7 +154,7 @@ fn main() -> ! {
         panic!("UART0 did not start");
     };
     let mut log = StrideLog::new(RATE);
-    log.banner("rp-pico", &live_app::config(RATE, ACCEL, GYRO), &mut serial);
+    log.banner("rp-pico", &CONFIG, &mut serial);
 
     let sda: Sda = pins.gpio4.reconfigure();
     let scl: Scl = pins.gpio5.reconfigure();

@@ -94,6 +94,19 @@ pub struct Counters {
     pub lost_samples: u32,
 }
 
+impl Counters {
+    /// Nothing went wrong yet (for a `static`, where `Default` is not `const`).
+    pub const ZERO: Counters = Counters {
+        bus_errors: 0,
+        restarts: 0,
+        recoveries: 0,
+        fifo_overflows: 0,
+        silences: 0,
+        overruns: 0,
+        lost_samples: 0,
+    };
+}
+
 /// The sensor, its settings and the fault bookkeeping.
 pub struct ImuSampler<I, D> {
     imu: Mpu6050<I>,

@@ -7,6 +7,7 @@
 //! - [`imu_sampler`]: the interrupt side, one data-ready pulse → one sample (or a FIFO
 //!   burst) into an SPSC queue, bus errors counted and retried, lost samples declared as
 //!   gaps.
+//! - [`live_settings`]: the rate, ranges and FIFO burst of the boards with a real sensor.
 //! - [`startup`]: what the user is told while the core calibrates itself.
 //! - [`serial_line`]: the line protocol of the UART output.
 //! - [`rsc`]: the Bluetooth Running Speed and Cadence encodings and the foot pod's state, and
@@ -44,6 +45,7 @@ pub const DETECTOR: Detector = if cfg!(feature = "peak-valley-detector") {
 };
 
 pub mod imu_sampler;
+pub mod live_settings;
 pub mod replay_holes;
 pub mod replay_mpu6050;
 pub mod rsc;

@@ -17,8 +17,6 @@ use embedded_hal::i2c::I2c;
 use gaitclip::detector::StepDetector;
 use gaitclip::mpu6050::{self, Mpu6050};
 use gaitclip::pipeline::{Config, Pipeline};
-use gaitclip::rate::SampleRate;
-use gaitclip::sample::{AccelRange, GyroRange};
 use gaitclip::stride::Stride;
 use heapless::spsc::{Consumer, Producer, Queue};
 
@@ -30,13 +28,6 @@ use crate::stride_log::StrideLog;
 /// Interval of the status line.
 pub const STATUS_EVERY_MS: u32 = 60_000;
 
-/// The pipeline's configuration for samples at `rate` in the given ranges, with the
-/// firmware's [`crate::DETECTOR`].
-pub const fn config(rate: SampleRate, accel: AccelRange, gyro: GyroRange) -> Config {
-    let mut c = Config::new(rate, accel.scale(), gyro.scale());
-    c.detector = crate::DETECTOR;
-    c
-}
 /// Period of the board's watchdog timer.
 pub const WATCHDOG_TICK_MS: u32 = 100;
 /// Watchdog ticks without a data-ready pulse after which the sensor is declared silent.
@@ -308,27 +299,6 @@ impl Watchdog {
 impl Default for Watchdog {
     fn default() -> Self {
         Self::new()
-    }
-}
-
-/// The sample rate of a sensor output rate in Hz (checked at compile time).
-pub const fn sample_rate(hz: u16) -> SampleRate {
-    match SampleRate::from_hz(hz as u32) {
-        Some(r) => r,
-        None => panic!("unsupported rate"),
-    }
-}
-
-/// The MPU6050's configuration for an output rate in Hz and the ranges (checked at compile
-/// time).
-pub const fn sensor_config(hz: u16, accel: AccelRange, gyro: GyroRange) -> mpu6050::Config {
-    mpu6050::Config {
-        rate: match mpu6050::OutputRate::from_hz(hz) {
-            Some(r) => r,
-            None => panic!("unsupported output rate"),
-        },
-        accel,
-        gyro,
     }
 }
 

@@ -52,9 +52,9 @@ pub const RATE: SampleRate = unwrap(SampleRate::from_millihertz(trace::RATE_MILL
 const ACCEL: AccelRange = unwrap(AccelRange::from_afs_sel(trace::ACCEL_AFS_SEL));
 const GYRO: GyroRange = unwrap(GyroRange::from_fs_sel(trace::GYRO_FS_SEL));
 /// The pipeline's configuration for the stored trace.
-pub const CONFIG: Config = crate::live_app::config(RATE, ACCEL, GYRO);
+pub const CONFIG: Config = crate::live_settings::config(RATE, ACCEL, GYRO);
 const SENSOR: mpu6050::Config =
-    crate::live_app::sensor_config((trace::RATE_MILLIHERTZ / 1000) as u16, ACCEL, GYRO);
+    crate::live_settings::sensor_config((trace::RATE_MILLIHERTZ / 1000) as u16, ACCEL, GYRO);
 
 /// Sampler, queue producer and pulse count, shared by the timer interrupt and the main loop.
 static LINK: SampleLink<ReplayMpu6050, SpinDelay> = SampleLink::new();
