@@ -111,7 +111,13 @@ impl GaitTimer {
             _ => None,
         };
         stride.gait = GaitParameters::of(stride, previous_heel_strike, self.rate);
-        self.previous = Some((stride.end, stride.heel_strike));
+        // A gap stride's heel-strike may sit in the hole (set to its first missing sample):
+        // the next stride times itself from its own cycle instead.
+        self.previous = if stride.flags.has(StrideFlags::GAP) {
+            None
+        } else {
+            Some((stride.end, stride.heel_strike))
+        };
     }
 }
 
@@ -257,6 +263,21 @@ mod tests {
         let mut third = stride(1600, 1700, 1780, 1820, 1500);
         timer.process(&mut third);
         assert_eq!(third.gait.stride_time_ms, 1100);
+    }
+
+    #[test]
+    fn a_gap_strides_heel_strike_times_nothing() {
+        let rate = SampleRate::from_hz(200).unwrap();
+        let mut timer = GaitTimer::new(rate);
+        // A gap stride whose heel-strike is the hole's first missing sample (1010).
+        let mut gap = stride(1000, 1005, 1010, 1220, 0);
+        gap.flags = StrideFlags(StrideFlags::GAP);
+        timer.process(&mut gap);
+        // The stride after it joins it, but times its own cycle (1100 ms), not 1410 − 1010.
+        let mut next = stride(1220, 1330, 1410, 1440, 1500);
+        timer.process(&mut next);
+        assert_eq!(next.gait.stride_time_ms, 1100);
+        assert_eq!(next.gait.stance_time_ms, 700);
     }
 
     #[test]
