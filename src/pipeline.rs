@@ -223,6 +223,8 @@ pub struct Pipeline<D = AnyDetector<MAX_MOVEMENT_SAMPLES>> {
     since_reset: u32,
     /// [`Pipeline::finish`] has flushed what was pending and is handing out what is held.
     finishing: bool,
+    /// The rest test's latest decision (false until its window has filled).
+    at_rest: bool,
 }
 
 impl Pipeline {
@@ -290,6 +292,7 @@ impl<D: StepDetector> Pipeline<D> {
             next: 0,
             since_reset: 0,
             finishing: false,
+            at_rest: false,
         }
     }
 
@@ -299,6 +302,13 @@ impl<D: StepDetector> Pipeline<D> {
     /// [`crate::stride::MAX_STANCE_IN_STRIDE_MS`] into it).
     pub fn latency(&self) -> u32 {
         self.detector.delay(self.filter.delay())
+    }
+
+    /// Whether the clip is still: the orientation-free rest test ([`crate::rest`]) on the
+    /// latest window of samples, false until a window has filled after the start or a
+    /// restart. What a board's sleep policy watches.
+    pub const fn at_rest(&self) -> bool {
+        self.at_rest
     }
 
     /// Number of the next sample to be fed.
@@ -434,6 +444,7 @@ impl<D: StepDetector> Pipeline<D> {
         self.since_reset = self.since_reset.saturating_add(1);
         let filtered = self.filter.process(s.accel);
         if let Some(rest) = self.rest.process(filtered, s.gyro) {
+            self.at_rest = rest;
             if self.since_reset > self.rest_delay {
                 let at = index.wrapping_sub(self.rest_delay);
                 self.frame.process(&self.lines.raw(at), rest);
@@ -568,6 +579,7 @@ impl<D: StepDetector> Pipeline<D> {
         self.since_reset = 0;
         self.filter = MeanFilter::with_len_log2(self.filter.window().trailing_zeros());
         self.rest.reset();
+        self.at_rest = false;
         self.frame.gap();
         // Measured last and once: a single stride on this frame while the models run keeps
         // the gap path's stack no deeper than a sample's.
