@@ -32,7 +32,7 @@ use core::fmt::Write;
 
 use defmt_rtt as _;
 use embassy_executor::{InterruptExecutor, Spawner};
-use embassy_futures::select::{select, Either};
+use embassy_futures::select::{select3, Either3};
 use embassy_nrf::gpio::Pull;
 use embassy_nrf::gpiote::{InputChannel, InputChannelPolarity};
 use embassy_nrf::interrupt::{self, InterruptExt, Priority};
@@ -50,6 +50,7 @@ use gaitclip_board::imu_sampler::{BusRecovery, Counters, ImuSampler, Item, ReadM
 use gaitclip_board::live_app::{self, Drain, SpinDelay, Watchdog, WATCHDOG_TICK_MS};
 use gaitclip_board::live_settings::{CONFIG, FIFO_BATCH, QUEUE_LEN, RATE, SENSOR};
 use gaitclip_board::rsc_gatt::{self, battery_percent, PodLink};
+use gaitclip_board::sleep::{SleepPolicy, SLEEP};
 use gaitclip_board::stride_log::StrideLog;
 use gaitclip_board::{serial_line, stack_paint, Steps};
 use heapless::spsc::{Consumer, Producer, Queue};
@@ -89,6 +90,10 @@ static PIPELINE: ConstStaticCell<Pipeline<Steps<MAX_MOVEMENT_SAMPLES>>> =
     ConstStaticCell::new(Pipeline::with_detector(CONFIG, Steps::new(&CONFIG)));
 /// Raised by the sampler after every data-ready pulse it handled.
 static QUEUED: Signal<CriticalSectionRawMutex, ()> = Signal::new();
+/// The pipeline task's sleep request for the sampler: the sample count to sleep after.
+static SLEEP_REQUEST: Signal<CriticalSectionRawMutex, u32> = Signal::new();
+/// Samples dropped after a wake-up while the gyro settles.
+const SETTLE: u32 = SleepPolicy::settle_samples(RATE, &SLEEP);
 /// The sampler's fault counters, for the status line.
 static COUNTERS: Mutex<CriticalSectionRawMutex, Cell<Counters>> =
     Mutex::new(Cell::new(Counters::ZERO));
@@ -196,7 +201,9 @@ async fn mpsl_task(mpsl: &'static MultiprotocolServiceLayer<'static>) -> ! {
     mpsl.run().await
 }
 
-/// The sampler: a FIFO burst every [`FIFO_BATCH`] pulses of INT, and the sensor watchdog.
+/// The sampler: a FIFO burst every [`FIFO_BATCH`] pulses of INT, and the sensor watchdog;
+/// while the sensor waits for motion ([`gaitclip_board::sleep`]), only INT, with no
+/// watchdog ticks, the slept periods timed on embassy's RTC time base.
 #[embassy_executor::task]
 async fn sampler_task(
     mut sampler: ImuSampler<Bus, SpinDelay>,
@@ -206,17 +213,34 @@ async fn sampler_task(
     let mut ticker = Ticker::every(Duration::from_millis(WATCHDOG_TICK_MS as u64));
     let mut watchdog = Watchdog::new();
     let mut pulses = 0u32;
+    let mut asleep_since = Instant::now();
     let mut push = |item| producer.enqueue(item).is_ok();
     loop {
-        match select(int.wait(), ticker.next()).await {
-            Either::First(()) => {
-                pulses = pulses.wrapping_add(1);
-                sampler.on_data_ready(&mut push);
-            }
-            Either::Second(()) => {
-                if let Some(lost) = watchdog.tick(pulses, RATE.samples_in_ms(WATCHDOG_TICK_MS)) {
-                    sampler.on_silence(lost, &mut push);
+        if sampler.asleep() {
+            int.wait().await;
+            let slept_us = Instant::now().duration_since(asleep_since).as_micros();
+            let slept = (slept_us * RATE.millihertz() as u64 / 1_000_000_000) as u32;
+            sampler.on_motion(slept, SETTLE, &mut push);
+            watchdog = Watchdog::new();
+            ticker.reset();
+            POD.set_asleep(false);
+        } else {
+            match select3(int.wait(), ticker.next(), SLEEP_REQUEST.wait()).await {
+                Either3::First(()) => {
+                    pulses = pulses.wrapping_add(1);
+                    sampler.on_data_ready(&mut push);
                 }
+                Either3::Second(()) => {
+                    if let Some(lost) = watchdog.tick(pulses, RATE.samples_in_ms(WATCHDOG_TICK_MS))
+                    {
+                        sampler.on_silence(lost, &mut push);
+                    }
+                }
+                Either3::Third(after) => sampler.request_sleep(after, SLEEP.wake),
+            }
+            if sampler.asleep() {
+                asleep_since = Instant::now();
+                POD.set_asleep(true);
             }
         }
         let c = sampler.counters();
@@ -233,7 +257,7 @@ async fn pipeline_task(
     mut log: StrideLog,
     mut serial: Serial,
 ) -> ! {
-    let mut drain = Drain::new(&CONFIG);
+    let mut drain = Drain::new(&CONFIG, QUEUE_LEN);
     let status_every = RATE.samples_in_ms(live_app::STATUS_EVERY_MS);
     let mut next_status = status_every;
     loop {
@@ -246,6 +270,9 @@ async fn pipeline_task(
             || COUNTERS.lock(|c| c.get()),
             |s| POD.stride(s, now_ms()),
         );
+        if let Some(after) = drain.take_sleep_request() {
+            SLEEP_REQUEST.signal(after);
+        }
         if drain.samples() >= next_status {
             next_status = next_status.wrapping_add(status_every);
             let (notified, unqueued, connections) = POD.counters();

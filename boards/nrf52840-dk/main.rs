@@ -13,6 +13,11 @@
 //! ([`imu_sampler`]), pushing samples into the queue. TIMER1 ticks the sensor watchdog. The
 //! main loop runs the pipeline and sleeps (`wfi`). Strides go to defmt over RTT
 //! (`probe-rs run`) and, as CSV lines, to the UART.
+//!
+//! Still for 10 s, the clip sleeps ([`gaitclip_board::sleep`]): the sensor waits for motion
+//! in its cycle mode, TIMER1 stops, the crystal oscillator is released (the PMU runs what
+//! needs a clock from the internal one) and the core sleeps in System ON until INT. RTC0,
+//! on the 32.768 kHz RC oscillator divided to 8 Hz, times the sleep (24 bits: 24 days).
 
 #![no_std]
 #![no_main]
@@ -33,7 +38,8 @@ use nrf52840_hal::{
     self as hal,
     gpio::{Floating, Input, Level, OpenDrainConfig, Pin},
     gpiote::Gpiote,
-    pac::{self, interrupt, TIMER1, TWIM0},
+    pac::{self, interrupt, RTC0, TIMER1, TWIM0},
+    rtc::Rtc,
     timer::{Periodic, Timer},
     twim::{self, Twim},
     uarte::{self, Uarte},
@@ -42,8 +48,9 @@ use panic_probe as _;
 use static_cell::ConstStaticCell;
 
 use gaitclip_board::live_settings::{CONFIG, FIFO_BATCH, QUEUE_LEN, RATE, SENSOR};
+use gaitclip_board::sleep::{SleepPolicy, SLEEP};
 use imu_sampler::{BusRecovery, Item, ReadMode};
-use live_app::{SampleLink, SpinDelay, Watchdog, WATCHDOG_TICK_MS};
+use live_app::{IntEvent, SampleLink, SpinDelay, Watchdog, WATCHDOG_TICK_MS};
 use stride_log::StrideLog;
 
 /// The core clock, 64 MHz.
@@ -95,6 +102,13 @@ impl BusRecovery for RecoverableTwim {
 
 /// Sampler, queue producer and pulse count, shared by the interrupts and the main loop.
 static LINK: SampleLink<RecoverableTwim, SpinDelay> = SampleLink::new();
+/// RTC0 at [`SLEEP_CLOCK_HZ`], and its count when the sensor went to sleep.
+type SleepClock = (Rtc<RTC0>, u32);
+static SLEEP_CLOCK: Mutex<RefCell<Option<SleepClock>>> = Mutex::new(RefCell::new(None));
+/// RTC0's rate: 32 768 Hz / (4095 + 1).
+const SLEEP_CLOCK_HZ: u32 = 8;
+/// Samples dropped after a wake-up while the gyro settles.
+const SETTLE: u32 = SleepPolicy::settle_samples(RATE, &SLEEP);
 static GPIOTE: Mutex<RefCell<Option<Gpiote>>> = Mutex::new(RefCell::new(None));
 /// TIMER1, ticking the watchdog.
 type WatchdogTimer = Timer<TIMER1, Periodic>;
@@ -109,7 +123,14 @@ fn main() -> ! {
     let Some(p) = pac::Peripherals::take() else {
         panic!("peripherals taken twice");
     };
-    let _clocks = hal::clocks::Clocks::new(p.CLOCK).enable_ext_hfosc();
+    let _clocks = hal::clocks::Clocks::new(p.CLOCK)
+        .enable_ext_hfosc()
+        .set_lfclk_src_rc()
+        .start_lfclk();
+    let Ok(rtc) = Rtc::new(p.RTC0, 4095) else {
+        panic!("RTC0 prescaler");
+    };
+    rtc.enable_counter();
     let port0 = hal::gpio::p0::Parts::new(p.P0);
 
     let mut serial = Uarte::new(
@@ -155,6 +176,7 @@ fn main() -> ! {
     irq::free(|cs| {
         GPIOTE.borrow(cs).replace(Some(gpiote));
         WATCHDOG.borrow(cs).replace(Some((timer, Watchdog::new())));
+        SLEEP_CLOCK.borrow(cs).replace(Some((rtc, 0)));
     });
     // Note(unsafe): both handlers only touch state behind `Mutex`es and atomics, so
     // unmasking cannot break a critical section.
@@ -173,7 +195,51 @@ fn GPIOTE() {
             g.channel0().reset_events();
         }
     });
-    LINK.on_data_ready();
+    irq::free(|cs| {
+        let mut clock = SLEEP_CLOCK.borrow(cs).borrow_mut();
+        let Some((rtc, asleep_at)) = clock.as_mut() else {
+            LINK.on_data_ready();
+            return;
+        };
+        let now = rtc.get_counter();
+        // 24-bit counter: the difference modulo 2²⁴ ticks of 125 ms, 25 periods each at
+        // 200 Hz (at most 4.2·10⁸: fits).
+        let slept = || {
+            let ticks = (now.wrapping_sub(*asleep_at) & 0xFF_FFFF) as u64;
+            (ticks * RATE.millihertz() as u64 / 1000 / SLEEP_CLOCK_HZ as u64) as u32
+        };
+        match LINK.on_int(SETTLE, slept) {
+            IntEvent::FellAsleep => {
+                *asleep_at = now;
+                set_awake_clocks(cs, false);
+            }
+            IntEvent::Woke => set_awake_clocks(cs, true),
+            IntEvent::Sampled => {}
+        }
+    });
+}
+
+/// Stops (asleep) or starts (awake) what only sampling needs: TIMER1's watchdog ticks and
+/// the crystal oscillator.
+fn set_awake_clocks(cs: &irq::CriticalSection, awake: bool) {
+    if let Some((timer, watchdog)) = WATCHDOG.borrow(cs).borrow_mut().as_mut() {
+        if awake {
+            *watchdog = Watchdog::new();
+            timer.start(WATCHDOG_TICK_MS * 1000);
+        } else {
+            // Note(unsafe): TASKS_STOP is a write-only trigger; 1 is its one value.
+            timer.task_stop().write(|w| unsafe { w.bits(1) });
+        }
+    }
+    // Note(unsafe): CLOCK's HFCLKSTART/HFCLKSTOP are write-only triggers (1 starts or stops
+    // the crystal); nothing else touches them after `main` set the clocks up, and the PMU
+    // keeps the internal oscillator for whatever needs a clock meanwhile.
+    let clock = unsafe { &*pac::CLOCK::ptr() };
+    if awake {
+        clock.tasks_hfclkstart.write(|w| unsafe { w.bits(1) });
+    } else {
+        clock.tasks_hfclkstop.write(|w| unsafe { w.bits(1) });
+    }
 }
 
 #[interrupt]

@@ -11,6 +11,12 @@
 //! Same firmware as the nRF52840 board: FIFO bursts on data-ready pulses, the shared sampler
 //! with retries, bus recovery and re-initialisation, the TIMER alarm as the sensor
 //! watchdog, the pipeline in the main loop with `wfi`, strides on defmt-RTT and the UART.
+//!
+//! Still for 10 s, the clip sleeps ([`gaitclip_board::sleep`]): the sensor waits for motion
+//! in its cycle mode and the watchdog alarm is not rearmed; the TIMER's microsecond count
+//! times the sleep. The core only waits in `wfi` with its clocks running: the RP2040's
+//! DORMANT state (0.18 mA typical, datasheet §5.7.2, Table 637) needs the clocks stopped and
+//! rebuilt around it, which this build does not do (README, energy budget).
 
 #![no_std]
 #![no_main]
@@ -44,8 +50,9 @@ use rp2040_hal::{
 use static_cell::ConstStaticCell;
 
 use gaitclip_board::live_settings::{CONFIG, FIFO_BATCH, QUEUE_LEN, RATE, SENSOR};
+use gaitclip_board::sleep::{SleepPolicy, SLEEP};
 use imu_sampler::{BusRecovery, Item, ReadMode};
-use live_app::{SampleLink, SpinDelay, Watchdog as SensorWatchdog, WATCHDOG_TICK_MS};
+use live_app::{IntEvent, SampleLink, SpinDelay, Watchdog as SensorWatchdog, WATCHDOG_TICK_MS};
 use stride_log::StrideLog;
 
 /// The second-stage bootloader for the Pico's W25Q080 flash.
@@ -113,6 +120,10 @@ impl BusRecovery for RecoverableI2c {
 static LINK: SampleLink<RecoverableI2c, SpinDelay> = SampleLink::new();
 static INT_PIN: Mutex<RefCell<Option<IntPin>>> = Mutex::new(RefCell::new(None));
 static WATCHDOG: Mutex<RefCell<Option<(Alarm0, SensorWatchdog)>>> = Mutex::new(RefCell::new(None));
+/// The TIMER, and its count (µs) when the sensor went to sleep.
+static SLEEP_CLOCK: Mutex<RefCell<Option<(Timer, u64)>>> = Mutex::new(RefCell::new(None));
+/// Samples dropped after a wake-up while the gyro settles.
+const SETTLE: u32 = SleepPolicy::settle_samples(RATE, &SLEEP);
 static QUEUE: ConstStaticCell<Queue<Item, QUEUE_LEN>> = ConstStaticCell::new(Queue::new());
 /// The pipeline's configuration.
 static PIPELINE: ConstStaticCell<Pipeline<Steps<MAX_MOVEMENT_SAMPLES>>> =
@@ -184,6 +195,7 @@ fn main() -> ! {
         WATCHDOG
             .borrow(cs)
             .replace(Some((alarm, SensorWatchdog::new())));
+        SLEEP_CLOCK.borrow(cs).replace(Some((timer, 0)));
     });
     // Note(unsafe): both handlers only touch state behind `Mutex`es and atomics, so
     // unmasking cannot break a critical section.
@@ -202,7 +214,29 @@ fn IO_IRQ_BANK0() {
             pin.clear_interrupt(PinInterrupt::EdgeHigh);
         }
     });
-    LINK.on_data_ready();
+    irq::free(|cs| {
+        let mut clock = SLEEP_CLOCK.borrow(cs).borrow_mut();
+        let Some((timer, asleep_at)) = clock.as_mut() else {
+            LINK.on_data_ready();
+            return;
+        };
+        let now = timer.get_counter().ticks();
+        let slept = || {
+            let us = now.saturating_sub(*asleep_at);
+            (us * RATE.millihertz() as u64 / 1_000_000_000).min(u32::MAX as u64) as u32
+        };
+        match LINK.on_int(SETTLE, slept) {
+            IntEvent::FellAsleep => *asleep_at = now,
+            IntEvent::Woke => {
+                // The watchdog starts over, its alarm rearmed.
+                if let Some((alarm, watchdog)) = WATCHDOG.borrow(cs).borrow_mut().as_mut() {
+                    *watchdog = SensorWatchdog::new();
+                    let _ = alarm.schedule(fugit::MicrosDurationU32::millis(WATCHDOG_TICK_MS));
+                }
+            }
+            IntEvent::Sampled => {}
+        }
+    });
 }
 
 #[interrupt]
@@ -211,6 +245,10 @@ fn TIMER_IRQ_0() {
         let mut wd = WATCHDOG.borrow(cs).borrow_mut();
         if let Some((alarm, watchdog)) = wd.as_mut() {
             alarm.clear_interrupt();
+            if LINK.asleep() {
+                // Not rearmed while the sensor sleeps: INT rearms it on waking.
+                return;
+            }
             let _ = alarm.schedule(fugit::MicrosDurationU32::millis(WATCHDOG_TICK_MS));
             LINK.on_watchdog_tick(watchdog, RATE.samples_in_ms(WATCHDOG_TICK_MS));
         }

@@ -80,7 +80,7 @@ fn samples(items: &[Item]) -> Vec<RawSample> {
         .iter()
         .filter_map(|i| match i {
             Item::Sample(s) => Some(*s),
-            Item::Gap(_) => None,
+            Item::Gap(_) | Item::Asleep | Item::Woke(_) => None,
         })
         .collect()
 }
@@ -112,7 +112,7 @@ fn a_sensor_that_stops_answering_is_restarted_and_the_hole_is_a_gap() {
         .iter()
         .map(|i| match i {
             Item::Gap(n) => *n,
-            Item::Sample(_) => 0,
+            Item::Sample(_) | Item::Asleep | Item::Woke(_) => 0,
         })
         .sum();
     // Restarts were attempted (bus recovered, set-up tried) while it did not answer; this
@@ -212,6 +212,8 @@ fn serial_stride_line_parses_back() {
         silences: u32::MAX,
         overruns: u32::MAX,
         lost_samples: u32::MAX,
+        sleeps: u32::MAX,
+        slept_periods: u32::MAX,
     };
     serial_line::status(&mut status, u32::MAX, u32::MAX, u64::MAX, &c).unwrap();
     assert!(status.len() <= serial_line::MAX_LINE, "{}", status.len());

@@ -271,7 +271,7 @@ fn a_sensor_that_stops_mid_walk_is_restarted_and_its_stride_marked() {
         .enumerate()
         .filter_map(|(k, i)| match i {
             Item::Gap(g) => Some((k, *g)),
-            Item::Sample(_) => None,
+            Item::Sample(_) | Item::Asleep | Item::Woke(_) => None,
         })
         .collect();
     assert_eq!(gaps, vec![(stop, OUT as u32)]);

@@ -7,7 +7,8 @@ use gaitclip::pipeline::{Config, Detector};
 use gaitclip::rate::SampleRate;
 use gaitclip::sample::RawSample;
 use gaitclip::stride::{Stride, StrideFlags};
-use gaitclip_board::replay_holes;
+use gaitclip_board::sleep::{SleepPolicy, SLEEP};
+use gaitclip_board::{replay_holes, replay_mpu6050, replay_still};
 use gaitclip_host::clock::Gap;
 use gaitclip_host::firmware::{self, parse_stride_line, LoggedStride};
 use gaitclip_host::qemu::{self, RunOptions};
@@ -240,4 +241,187 @@ fn strides_equal_host_replay(
             .any(|l| l.starts_with("still: gyro_bias_mdps=")),
         "no start-up calibration report"
     );
+}
+
+/// The demo walk with the still runs of `boards/common/src/replay_still.rs`, as the emulated
+/// sensor serves it with the `replay-sleep` feature: each listed sample held for its run.
+fn still_trace(counts: &[RawSample]) -> Vec<RawSample> {
+    let mut out = Vec::new();
+    for (i, s) in counts.iter().enumerate() {
+        out.push(*s);
+        for &(at, extra) in replay_still::STILL {
+            if at as usize == i {
+                out.extend(std::iter::repeat_n(*s, extra as usize));
+            }
+        }
+    }
+    out
+}
+
+/// The host model of the sleeping firmware on `trace`: the pipeline and the firmware's
+/// sleep policy sample by sample; once a sleep is due (the queue's length past the
+/// decision), the sensor's cycle mode wakes on its own clock every wake period and compares
+/// with the wake-up before; on motion the gyro's settling samples are dropped and every
+/// unsampled period declared as one hole. Returns the strides, the samples processed, the
+/// sleeps and the periods slept (those of a sleep that lasted to the end uncounted).
+fn sleeping_host_model(trace: &[RawSample], config: Config) -> (Vec<Stride>, u32, u32, u32) {
+    let mut p = gaitclip::pipeline::Pipeline::new(config);
+    let mut policy = SleepPolicy::new(config.rate, &SLEEP);
+    let period = (config.rate.millihertz() / SLEEP.wake.rate.millihertz()) as usize;
+    let threshold = replay_mpu6050::mg_to_counts(
+        SLEEP.wake.threshold.mg(replay_mpu6050::REPLAY_MOTION_UNIT),
+        Ranges::default().accel.afs_sel(),
+    );
+    let settle = SleepPolicy::settle_samples(config.rate, &SLEEP) as usize;
+    let (mut strides, mut processed, mut sleeps, mut slept_total) = (Vec::new(), 0u32, 0, 0);
+    let mut sleep_after = None;
+    let mut pos = 0usize;
+    while pos < trace.len() {
+        let st = p.process(&trace[pos]);
+        pos += 1;
+        processed += 1;
+        if policy.after_sample(p.at_rest(), st.is_some()) {
+            sleep_after = Some(SleepPolicy::sleep_after(processed, REPLAY_QUEUE_LEN));
+        }
+        strides.extend(st);
+        if sleep_after.is_some_and(|at| processed >= at) {
+            sleep_after = None;
+            policy.reset();
+            sleeps += 1;
+            let from = pos;
+            let mut t = pos.div_ceil(period) * period;
+            let woke = loop {
+                if t >= trace.len() {
+                    break None;
+                }
+                if t >= period
+                    && replay_mpu6050::motion_between(
+                        trace[t - period].accel,
+                        trace[t].accel,
+                        threshold,
+                    )
+                {
+                    break Some(t + 1);
+                }
+                t += period;
+            };
+            // Asleep to the end of the recording.
+            let Some(next) = woke else { break };
+            let unsampled = (next - from + settle) as u32;
+            slept_total += unsampled;
+            pos = next + settle;
+            strides.extend(p.gap(unsampled));
+        }
+    }
+    strides.extend(std::iter::from_fn(|| p.finish()));
+    (strides, processed, sleeps, slept_total)
+}
+
+/// The queue between the replay firmware's timer interrupt and its main loop
+/// (`replay_app::QUEUE_LEN`).
+const REPLAY_QUEUE_LEN: usize = 32;
+
+/// The emulated M4 board, its sensor holding still for 12 s in the middle of the demo walk
+/// and 13 s at its end: the firmware sleeps after 10 s still, the sensor's cycle mode wakes it
+/// on the first step, and it sleeps again to the end, logging exactly the strides of the host
+/// model of the same. The step the wake-up cut into is a gap stride; the strides after it
+/// come out as they do in the replay that never slept.
+#[test]
+fn qemu_m4_sleeps_when_still_and_wakes_as_the_host_model() {
+    if !qemu::available_or_skip() {
+        return;
+    }
+    let env = [("CARGO_TARGET_DIR", "target/replay-sleep".as_ref())];
+    let elf = firmware::build_with(
+        "boards/mps2-an386",
+        "mps2-an386",
+        "thumbv7em-none-eabihf",
+        &["--features", "replay-sleep"],
+        &env,
+    )
+    .expect("firmware builds");
+    let out = qemu::run(
+        &elf,
+        &RunOptions {
+            machine: qemu::MACHINE_M4.into(),
+            fast: true,
+            extra_args: Vec::new(),
+        },
+        |_| {},
+    )
+    .expect("qemu runs");
+    assert_eq!(out.status, 0, "log:\n{}", out.lines.join("\n"));
+    let on_target: Vec<LoggedStride> = out
+        .lines
+        .iter()
+        .filter_map(|l| parse_stride_line(l))
+        .collect();
+
+    let counts = gaitclip_host::fixtures::firmware_trace_counts().unwrap();
+    let ranges = Ranges::default();
+    let config = Config::new(
+        SampleRate::from_hz(200).unwrap(),
+        ranges.accel.scale(),
+        ranges.gyro.scale(),
+    );
+    let (host, processed, sleeps, slept) = sleeping_host_model(&still_trace(&counts), config);
+    let host_logged: Vec<LoggedStride> = host.iter().map(LoggedStride::of).collect();
+    assert_eq!(on_target, host_logged);
+
+    // It slept twice and woke once, and said so.
+    assert_eq!(sleeps, 2);
+    let count = |prefix: &str| out.lines.iter().filter(|l| l.starts_with(prefix)).count();
+    assert_eq!(count("sleep: still for"), 2, "{}", out.lines.join("\n"));
+    assert_eq!(count("wake: motion after"), 1, "{}", out.lines.join("\n"));
+    let summary = out
+        .lines
+        .iter()
+        .find(|l| l.starts_with("summary"))
+        .expect("summary line");
+    for field in [
+        format!("samples={processed}"),
+        "sleeps=2".to_string(),
+        format!("slept_periods={slept}"),
+        "lost_samples=0".to_string(),
+        "overruns=0".to_string(),
+    ] {
+        assert!(summary.contains(&field), "{field} not in {summary}");
+    }
+
+    // The step the wake-up cut into is a gap stride, flagged, not dropped; every stride
+    // after it has the length, events and gait of the replay that never slept (its sample
+    // indices later by the periods the still runs added), but the first: after a gap it
+    // times its own cycle, with no heel-strike before it.
+    let awake = replay_counts_with(&counts, config, |i| i as f64);
+    let wake_at = host
+        .iter()
+        .position(|s| s.flags.has(StrideFlags::GAP))
+        .expect("a gap stride at the wake-up");
+    let held: u32 = replay_still::STILL[0].1;
+    let after_wake = &host[wake_at + 1..];
+    assert!(after_wake.len() >= 5, "{after_wake:#?}");
+    for (k, s) in after_wake.iter().enumerate() {
+        let twin = awake
+            .iter()
+            .map(|a| &a.raw)
+            .find(|a| a.start + held == s.start)
+            .unwrap_or_else(|| panic!("no stride of the awake replay matches {s:#?}"));
+        assert_eq!(
+            (s.length_mm, s.end, s.heel_strike, s.flags),
+            (
+                twin.length_mm,
+                twin.end + held,
+                twin.heel_strike + held,
+                twin.flags
+            )
+        );
+        if k == 0 {
+            assert_eq!(
+                u32::from(s.gait.stride_time_ms),
+                config.rate.ms_of_samples(s.end - s.start)
+            );
+        } else {
+            assert_eq!(s.gait, twin.gait);
+        }
+    }
 }

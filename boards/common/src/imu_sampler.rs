@@ -13,7 +13,9 @@
 //!   SCL, [`BusRecovery`]) and the sensor re-initialised; what it lost meanwhile is a gap;
 //! - a FIFO overflow, or a queue with no room, is a gap of the samples it cost;
 //! - a sensor that stops pulsing altogether is found by the board's watchdog, which calls
-//!   [`ImuSampler::on_silence`].
+//!   [`ImuSampler::on_silence`];
+//! - the periods the sensor spent asleep ([`ImuSampler::request_sleep`], [`crate::sleep`])
+//!   and the gyro's settling after it are one [`Item::Woke`], declared like a gap.
 //!
 //! Board glue, shared: generic over the bus and delay, so the host tests drive it with
 //! `embedded-hal-mock`.
@@ -21,7 +23,7 @@
 use embedded_hal::delay::DelayNs;
 use embedded_hal::i2c::I2c;
 use gaitclip::detector::StepDetector;
-use gaitclip::mpu6050::{self, Mpu6050};
+use gaitclip::mpu6050::{self, MotionWake, Mpu6050};
 use gaitclip::pipeline::Pipeline;
 use gaitclip::sample::RawSample;
 use gaitclip::stride::Stride;
@@ -42,6 +44,14 @@ pub enum Item {
     /// This many sample periods were lost here: the pipeline reports the stride in progress
     /// as a gap stride (invalid, no length) instead of measuring across the hole.
     Gap(u32),
+    /// The sensor went to its low-power wait for motion after the sample before this
+    /// ([`ImuSampler::request_sleep`]): nothing follows until [`Item::Woke`].
+    Asleep,
+    /// The sensor woke on motion and samples again: this many sample periods went
+    /// unsampled (asleep, and the gyro's settling after it). The pipeline takes them as a
+    /// hole, which restarts detection: a walk that began while the sensor woke is a gap
+    /// stride, flagged, not dropped.
+    Woke(u32),
 }
 
 impl Item {
@@ -50,7 +60,8 @@ impl Item {
     pub fn feed<D: StepDetector>(self, pipeline: &mut Pipeline<D>) -> Option<Stride> {
         match self {
             Item::Sample(s) => pipeline.process(&s),
-            Item::Gap(n) => pipeline.gap(n),
+            Item::Gap(n) | Item::Woke(n) => pipeline.gap(n),
+            Item::Asleep => None,
         }
     }
 }
@@ -92,6 +103,10 @@ pub struct Counters {
     pub overruns: u32,
     /// Sample periods reported as gaps.
     pub lost_samples: u32,
+    /// Times the sensor went to its low-power wait for motion.
+    pub sleeps: u32,
+    /// Sample periods spent there (and settling after it), not counted as lost.
+    pub slept_periods: u32,
 }
 
 impl Counters {
@@ -104,6 +119,8 @@ impl Counters {
         silences: 0,
         overruns: 0,
         lost_samples: 0,
+        sleeps: 0,
+        slept_periods: 0,
     };
 }
 
@@ -120,6 +137,18 @@ pub struct ImuSampler<I, D> {
     /// Lost periods not yet handed to the queue.
     pending_gap: u32,
     counters: Counters,
+    /// Samples read and handed on so far, not counting those dropped while the gyro
+    /// settles (what [`ImuSampler::request_sleep`] counts).
+    read: u32,
+    /// Go to the low-power wait once this many samples have been read, with these settings.
+    sleep_request: Option<(u32, MotionWake)>,
+    /// In the low-power wait for motion.
+    asleep: bool,
+    /// Samples still to drop after waking while the gyro settles.
+    settling: u32,
+    /// Periods unsampled since the sensor went to sleep, not yet handed over as
+    /// [`Item::Woke`].
+    pending_woke: u32,
 }
 
 impl<I, D> ImuSampler<I, D>
@@ -145,6 +174,11 @@ where
             failed_periods: 0,
             pending_gap: 0,
             counters: Counters::default(),
+            read: 0,
+            sleep_request: None,
+            asleep: false,
+            settling: 0,
+            pending_woke: 0,
         };
         match s.setup() {
             Ok(()) => Ok(s),
@@ -166,6 +200,18 @@ where
     /// Hands `item` to `push` (which returns `false` when the queue is full), reporting any
     /// pending gap first; what does not fit joins the gap.
     fn emit(&mut self, push: &mut impl FnMut(Item) -> bool, item: Item) {
+        if self.pending_woke > 0 {
+            if !push(Item::Woke(self.pending_woke)) {
+                self.counters.overruns = self.counters.overruns.saturating_add(1);
+                if let Item::Sample(_) = item {
+                    // Joins the unsampled periods: the pipeline restarts after them anyway.
+                    self.pending_woke = self.pending_woke.saturating_add(1);
+                    self.counters.slept_periods = self.counters.slept_periods.saturating_add(1);
+                }
+                return;
+            }
+            self.pending_woke = 0;
+        }
         if self.pending_gap > 0 {
             if !push(Item::Gap(self.pending_gap)) {
                 self.counters.overruns = self.counters.overruns.saturating_add(1);
@@ -184,8 +230,13 @@ where
         }
     }
 
-    /// The data-ready interrupt: reads what is due and hands it to `push`.
+    /// The data-ready interrupt: reads what is due and hands it to `push`; then, if a sleep
+    /// is due ([`ImuSampler::request_sleep`]), sends the sensor to its wait for motion.
+    /// Ignored while asleep (the board calls [`ImuSampler::on_motion`] for the INT pin then).
     pub fn on_data_ready(&mut self, push: &mut impl FnMut(Item) -> bool) {
+        if self.asleep {
+            return;
+        }
         match self.mode {
             ReadMode::PerSample => self.read_one(push),
             ReadMode::Fifo { batch } => {
@@ -195,11 +246,113 @@ where
                 }
             }
         }
+        if let Some((at, wake)) = self.sleep_request {
+            if self.read >= at {
+                self.sleep_request = None;
+                self.enter_sleep(&wake, push);
+            }
+        }
+    }
+
+    /// Samples read and handed on so far (the main loop's count of samples, plus what is
+    /// queued and what the queue had no room for).
+    pub const fn samples_read(&self) -> u32 {
+        self.read
+    }
+
+    /// Whether the sensor is in its low-power wait for motion.
+    pub const fn asleep(&self) -> bool {
+        self.asleep
+    }
+
+    /// Sends the sensor to its low-power wait for motion ([`Mpu6050::enter_motion_wake`])
+    /// once `after` samples have been handed on in all ([`ImuSampler::samples_read`]). The main
+    /// loop decides on what it has processed, while the interrupt may have read a few more:
+    /// it asks for a count ahead of anything the queue can hold, so the sleep falls after
+    /// the same sample however far behind it ran (the replay's host model relies on it).
+    /// Replaces an earlier request.
+    pub fn request_sleep(&mut self, after: u32, wake: MotionWake) {
+        self.sleep_request = Some((after, wake));
+    }
+
+    fn enter_sleep(&mut self, wake: &MotionWake, push: &mut impl FnMut(Item) -> bool) {
+        for _ in 0..=RETRIES {
+            match self.imu.enter_motion_wake(wake, self.config.accel) {
+                Ok(()) => {
+                    self.asleep = true;
+                    self.unread = 0;
+                    self.counters.sleeps = self.counters.sleeps.saturating_add(1);
+                    if !push(Item::Asleep) {
+                        self.counters.overruns = self.counters.overruns.saturating_add(1);
+                    }
+                    return;
+                }
+                Err(_) => self.counters.bus_errors = self.counters.bus_errors.saturating_add(1),
+            }
+        }
+        // Half configured: set the sensor up again and stay awake; the main loop asks
+        // again after another still period.
+        self.restart();
+    }
+
+    /// The INT pin rose while asleep: motion. Back to full sampling
+    /// ([`Mpu6050::leave_motion_wake`], then the interrupt and FIFO as at start), dropping the first
+    /// `settle` samples (the gyro's start-up, datasheet §6.1: 30 ms); `slept` sample periods
+    /// passed while asleep (the board's low-power clock). Both become one [`Item::Woke`]
+    /// before the first sample kept. On a bus error the sensor is set up again from reset.
+    pub fn on_motion(&mut self, slept: u32, settle: u32, push: &mut impl FnMut(Item) -> bool) {
+        if !self.asleep {
+            return;
+        }
+        self.asleep = false;
+        self.settling = settle;
+        self.pending_woke = self.pending_woke.saturating_add(slept);
+        self.counters.slept_periods = self.counters.slept_periods.saturating_add(slept);
+        let mut resumed = false;
+        for _ in 0..=RETRIES {
+            if self.resume().is_ok() {
+                resumed = true;
+                break;
+            }
+            self.counters.bus_errors = self.counters.bus_errors.saturating_add(1);
+        }
+        if !resumed {
+            self.restart();
+        }
+        if self.pending_woke > 0 && self.settling == 0 && push(Item::Woke(self.pending_woke)) {
+            self.pending_woke = 0;
+        }
+    }
+
+    fn resume(&mut self) -> Result<(), mpu6050::Error<I::Error>> {
+        self.imu.leave_motion_wake(&self.config)?;
+        self.enable_interrupt()
+    }
+
+    /// Counts a sample read; true if it is kept (not dropped while the gyro settles).
+    fn keep(&mut self) -> bool {
+        if self.settling > 0 {
+            self.settling -= 1;
+            self.pending_woke = self.pending_woke.saturating_add(1);
+            self.counters.slept_periods = self.counters.slept_periods.saturating_add(1);
+            return false;
+        }
+        self.read = self.read.wrapping_add(1);
+        true
+    }
+
+    /// The bus, for a board's emulated sensor (its clock in the low-power wait) and tests.
+    pub fn bus_mut(&mut self) -> &mut I {
+        self.imu.bus_mut()
     }
 
     /// The board's watchdog found no data-ready pulse for `periods` sample periods: the
     /// sensor was reset or lost power. They become a gap and the sensor is set up again.
     pub fn on_silence(&mut self, periods: u32, push: &mut impl FnMut(Item) -> bool) {
+        if self.asleep {
+            // Silent by design: the sensor only speaks again on motion.
+            return;
+        }
         self.counters.silences = self.counters.silences.saturating_add(1);
         let lost = periods.saturating_add(core::mem::take(&mut self.unread));
         self.lost(lost);
@@ -214,7 +367,9 @@ where
             match self.imu.read_sample() {
                 Ok(s) => {
                     self.failed_periods = 0;
-                    self.emit(push, Item::Sample(s));
+                    if self.keep() {
+                        self.emit(push, Item::Sample(s));
+                    }
                     return;
                 }
                 Err(_) => self.counters.bus_errors = self.counters.bus_errors.saturating_add(1),
@@ -236,7 +391,9 @@ where
                     self.failed_periods = 0;
                     self.unread = self.unread.saturating_sub(n as u32);
                     for s in &buf[..n] {
-                        self.emit(push, Item::Sample(*s));
+                        if self.keep() {
+                            self.emit(push, Item::Sample(*s));
+                        }
                     }
                     if n < FIFO_BURST {
                         // Pulses counted but not in the FIFO: none are waiting any more.
@@ -292,6 +449,12 @@ where
 
     fn setup(&mut self) -> Result<(), mpu6050::Error<I::Error>> {
         self.imu.init(&mut self.delay, &self.config)?;
+        // A reset sensor is awake whatever it was doing.
+        self.asleep = false;
+        self.enable_interrupt()
+    }
+
+    fn enable_interrupt(&mut self) -> Result<(), mpu6050::Error<I::Error>> {
         match self.mode {
             ReadMode::PerSample => self.imu.enable_data_ready_interrupt(),
             ReadMode::Fifo { .. } => {

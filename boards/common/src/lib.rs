@@ -10,10 +10,12 @@
 //! - [`live_settings`]: the rate, ranges and FIFO burst of the boards with a real sensor.
 //! - [`startup`]: what the user is told while the core calibrates itself.
 //! - [`serial_line`]: the line protocol of the UART output.
+//! - [`sleep`]: when the clip sleeps (still for 10 s) and how it wakes on the first step.
 //! - [`rsc`]: the Bluetooth Running Speed and Cadence encodings and the foot pod's state, and
 //!   with the `ble` feature `rsc_gatt`, its GATT server on trouble-host.
-//! - [`replay_mpu6050`] and [`replay_holes`]: an MPU6050 on an emulated I²C bus serving a
-//!   stored trace, for the QEMU boards and the host tests.
+//! - [`replay_mpu6050`], [`replay_holes`] and [`replay_still`]: an MPU6050 on an emulated
+//!   I²C bus serving a stored trace (losing samples, standing still, sleeping in its cycle
+//!   mode), for the QEMU boards and the host tests.
 //! - On a Cortex-M only: `live_app` (the main loop of a board with a real sensor),
 //!   `stride_log` (defmt and the serial line), `registers` (memory-mapped peripherals),
 //!   and with the `replay` feature
@@ -48,10 +50,12 @@ pub mod imu_sampler;
 pub mod live_settings;
 pub mod replay_holes;
 pub mod replay_mpu6050;
+pub mod replay_still;
 pub mod rsc;
 #[cfg(feature = "ble")]
 pub mod rsc_gatt;
 pub mod serial_line;
+pub mod sleep;
 pub mod startup;
 
 #[cfg(target_os = "none")]

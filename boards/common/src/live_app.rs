@@ -22,6 +22,7 @@ use heapless::spsc::{Consumer, Producer, Queue};
 
 use crate::imu_sampler::{BusRecovery, Counters, ImuSampler, Item, ReadMode};
 use crate::serial_line;
+use crate::sleep::{SleepPolicy, SLEEP};
 use crate::startup::Startup;
 use crate::stride_log::StrideLog;
 
@@ -116,6 +117,29 @@ where
         self.with(|s, mut push| s.on_data_ready(&mut push));
     }
 
+    /// The body of the INT pin's interrupt on a board that sleeps: data ready while the
+    /// sensor samples; motion while it waits in its cycle mode, when `slept()` gives the
+    /// sample periods since it went to sleep (the board's low-power clock) and the first
+    /// `settle` samples after it are dropped ([`ImuSampler::on_motion`]). Says what changed,
+    /// for the board to stop its watchdog timer and note its clock, or start them again.
+    pub fn on_int(&self, settle: u32, slept: impl FnOnce() -> u32) -> IntEvent {
+        self.with_sampler(|s, mut push| {
+            if s.asleep() {
+                s.on_motion(slept(), settle, &mut push);
+                return IntEvent::Woke;
+            }
+            self.pulses
+                .store(self.pulses().wrapping_add(1), Ordering::Relaxed);
+            s.on_data_ready(&mut push);
+            if s.asleep() {
+                IntEvent::FellAsleep
+            } else {
+                IntEvent::Sampled
+            }
+        })
+        .unwrap_or(IntEvent::Sampled)
+    }
+
     /// The body of the watchdog timer's interrupt: `periods_per_tick` sample periods
     /// elapse per tick.
     pub fn on_watchdog_tick(&self, watchdog: &mut Watchdog, periods_per_tick: u32) {
@@ -134,7 +158,7 @@ where
         log: &mut StrideLog,
         serial: &mut impl Write,
     ) -> ! {
-        let mut drain = Drain::new(config);
+        let mut drain = Drain::new(config, consumer.capacity());
         loop {
             drain.run(
                 pipeline,
@@ -144,6 +168,9 @@ where
                 || self.counters(),
                 |_| {},
             );
+            if let Some(after) = drain.take_sleep_request() {
+                self.request_sleep(after, SLEEP.wake);
+            }
             // Interrupts are masked while checking the queue so that a sample arriving between
             // the check and `wfi` still wakes the core (WFI wakes on a pending interrupt even
             // with PRIMASK set).
@@ -158,14 +185,45 @@ where
     }
 
     fn with(&self, f: impl FnOnce(&mut ImuSampler<I, D>, &mut dyn FnMut(Item) -> bool)) {
+        self.with_sampler(f);
+    }
+
+    /// Runs `f` on the sampler and a push into the queue, in a critical section; `None`
+    /// before [`SampleLink::install`].
+    pub fn with_sampler<R>(
+        &self,
+        f: impl FnOnce(&mut ImuSampler<I, D>, &mut dyn FnMut(Item) -> bool) -> R,
+    ) -> Option<R> {
         irq::free(|cs| {
             let mut sampler = self.sampler.borrow(cs).borrow_mut();
             let mut producer = self.producer.borrow(cs).borrow_mut();
-            if let (Some(s), Some(p)) = (sampler.as_mut(), producer.as_mut()) {
-                f(s, &mut |item| p.enqueue(item).is_ok());
+            match (sampler.as_mut(), producer.as_mut()) {
+                (Some(s), Some(p)) => Some(f(s, &mut |item| p.enqueue(item).is_ok())),
+                _ => None,
             }
-        });
+        })
     }
+
+    /// Whether the sensor is in its wait for motion.
+    pub fn asleep(&self) -> bool {
+        self.with_sampler(|s, _| s.asleep()).unwrap_or(false)
+    }
+
+    /// Asks the sampler to sleep after `after` samples in all ([`ImuSampler::request_sleep`]).
+    pub fn request_sleep(&self, after: u32, wake: gaitclip::mpu6050::MotionWake) {
+        self.with_sampler(|s, _| s.request_sleep(after, wake));
+    }
+}
+
+/// What an INT interrupt did ([`SampleLink::on_int`]).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum IntEvent {
+    /// Samples read (or counted), as usual.
+    Sampled,
+    /// The sensor went to its wait for motion after this read.
+    FellAsleep,
+    /// The sensor woke on motion and samples again.
+    Woke,
 }
 
 /// The main loop's work on what the sampler queued: the pipeline, start-up reporting, the
@@ -176,18 +234,42 @@ pub struct Drain {
     status_every_samples: u32,
     samples: u32,
     next_status: u32,
+    policy: SleepPolicy,
+    /// Items the board's queue holds (how far ahead the sampler can have read).
+    queue_len: usize,
+    /// A sleep the policy asked for, for the board to hand to the sampler.
+    sleep_request: Option<u32>,
+    /// The sensor is in its wait for motion (between [`Item::Asleep`] and [`Item::Woke`]).
+    asleep: bool,
 }
 
 impl Drain {
-    /// Nothing processed yet, for a pipeline configured by `config`.
-    pub fn new(config: &Config) -> Self {
+    /// Nothing processed yet, for a pipeline configured by `config` fed from a queue of
+    /// `queue_len` items.
+    pub fn new(config: &Config, queue_len: usize) -> Self {
         let status_every_samples = config.rate.samples_in_ms(STATUS_EVERY_MS);
         Drain {
             startup: Startup::new(config.rate, config.gyro),
             status_every_samples,
             samples: 0,
             next_status: status_every_samples,
+            policy: SleepPolicy::new(config.rate, &SLEEP),
+            queue_len,
+            sleep_request: None,
+            asleep: false,
         }
+    }
+
+    /// The sleep the policy asked for since the last call: the sample count to hand to
+    /// [`SampleLink::request_sleep`] (or [`ImuSampler::request_sleep`]).
+    pub fn take_sleep_request(&mut self) -> Option<u32> {
+        self.sleep_request.take()
+    }
+
+    /// Whether the sensor is in its wait for motion: the board stops its sensor watchdog
+    /// and slows its radio.
+    pub const fn asleep(&self) -> bool {
+        self.asleep
     }
 
     /// Samples processed so far.
@@ -209,11 +291,30 @@ impl Drain {
     ) {
         while let Some(item) = consumer.dequeue() {
             let stride = item.feed(pipeline);
-            if let Item::Sample(_) = item {
-                self.samples = self.samples.wrapping_add(1);
-                if let Some(e) = self.startup.update(pipeline) {
-                    log.startup(e, serial);
+            match item {
+                Item::Sample(_) => {
+                    self.samples = self.samples.wrapping_add(1);
+                    if let Some(e) = self.startup.update(pipeline) {
+                        log.startup(e, serial);
+                    }
+                    if self
+                        .policy
+                        .after_sample(pipeline.at_rest(), stride.is_some())
+                    {
+                        self.sleep_request =
+                            Some(SleepPolicy::sleep_after(self.samples, self.queue_len));
+                    }
                 }
+                Item::Asleep => {
+                    log.asleep(self.policy.still_samples(), &SLEEP, serial);
+                    self.policy.reset();
+                    self.asleep = true;
+                }
+                Item::Woke(_) => {
+                    self.policy.reset();
+                    self.asleep = false;
+                }
+                Item::Gap(_) => self.policy.reset(),
             }
             if let Some(stride) = &stride {
                 log.stride(stride, serial);
@@ -224,8 +325,9 @@ impl Drain {
                     self.next_status = self.next_status.wrapping_add(self.status_every_samples);
                     log.summary(self.samples, &counters(), serial);
                 }
-                Item::Sample(_) => {}
                 Item::Gap(n) => log.gap(n, pipeline.hole_kind(n), serial),
+                Item::Woke(n) => log.woke(n, serial),
+                Item::Sample(_) | Item::Asleep => {}
             }
         }
     }

@@ -7,6 +7,12 @@
 //! pipeline, reports start-up, strides and gaps, and sleeps with `wfi` when the queue is
 //! empty. When the trace ends it logs a summary and exits QEMU through semihosting with
 //! status 0; a panic or HardFault exits with status 1 ([`fail`]).
+//!
+//! It sleeps as the boards with a real sensor do ([`crate::sleep`]): still for 10 s, the
+//! emulated sensor goes to its cycle mode and the timer, standing in for the sensor's own
+//! clock now, ticks at the wake rate ([`ReplayMpu6050::wake_tick`]) until the trace moves;
+//! then full sampling resumes. The demo walk never stands that long; with the
+//! `replay-sleep` feature the sensor holds still for the runs of [`STILL`].
 
 use core::sync::atomic::{AtomicBool, Ordering};
 
@@ -21,7 +27,8 @@ use heapless::spsc::Queue;
 
 use crate::imu_sampler::{ImuSampler, Item, ReadMode};
 use crate::live_app::{SampleLink, SpinDelay};
-use crate::replay_mpu6050::ReplayMpu6050;
+use crate::replay_mpu6050::{ReplayMpu6050, WakeTick};
+use crate::sleep::{SleepPolicy, SLEEP};
 use crate::startup::Startup;
 use crate::stride_log::{NoSerial, StrideLog};
 use crate::trace;
@@ -36,9 +43,17 @@ pub const QUEUE_LEN: usize = 32;
 pub const LOST: &[(u32, u32)] = &[];
 #[cfg(feature = "replay-holes")]
 pub use crate::replay_holes::LOST;
+/// Runs of periods the emulated sensor holds still: none, or with the `replay-sleep`
+/// feature [`crate::replay_still::STILL`].
+#[cfg(not(feature = "replay-sleep"))]
+pub const STILL: &[(u32, u32)] = &[];
+#[cfg(feature = "replay-sleep")]
+pub use crate::replay_still::STILL;
 
-/// Samples in the stored trace: the number of data-ready pulses the timer gives.
+/// Samples in the stored trace.
 pub const TRACE_SAMPLES: u32 = (trace::REGISTERS.len() / SAMPLE_BYTES) as u32;
+/// Samples dropped after a wake-up while the gyro settles.
+const SETTLE: u32 = SleepPolicy::settle_samples(RATE, &SLEEP);
 
 const fn unwrap<T: Copy>(v: Option<T>) -> T {
     match v {
@@ -100,7 +115,13 @@ pub fn run<D: StepDetector, T: SampleTimer>(
     // Note(unsafe): `run` is the one caller besides the handler (`SampleTimer::steal`).
     let timer = unsafe { T::steal() };
     let imu = Mpu6050::new(
-        ReplayMpu6050::new(Address::Ad0Low.bits(), trace::REGISTERS, LOST),
+        ReplayMpu6050::with_still(
+            Address::Ad0Low.bits(),
+            trace::REGISTERS,
+            trace::RATE_MILLIHERTZ,
+            STILL,
+            LOST,
+        ),
         Address::Ad0Low,
     );
     let sampler = match ImuSampler::start(
@@ -133,10 +154,18 @@ pub fn run<D: StepDetector, T: SampleTimer>(
     unsafe { cortex_m::peripheral::NVIC::unmask(Irq(T::IRQ)) };
 
     let mut startup = Startup::new(RATE, GYRO.scale());
+    let mut policy = SleepPolicy::new(RATE, &SLEEP);
     let mut samples = 0u32;
     loop {
         while let Some(item) = consumer.dequeue() {
-            handle(item, pipeline, &mut startup, &mut log, &mut samples);
+            handle(
+                item,
+                pipeline,
+                &mut startup,
+                &mut policy,
+                &mut log,
+                &mut samples,
+            );
         }
         if TRACE_DONE.load(Ordering::Acquire) && !consumer.ready() {
             timer.stop();
@@ -163,6 +192,7 @@ fn handle<D: StepDetector>(
     item: Item,
     pipeline: &mut Pipeline<D>,
     startup: &mut Startup,
+    policy: &mut SleepPolicy,
     log: &mut StrideLog,
     samples: &mut u32,
 ) {
@@ -174,15 +204,24 @@ fn handle<D: StepDetector>(
             if let Some(e) = startup.update(pipeline) {
                 log.startup(e, serial);
             }
+            if policy.after_sample(pipeline.at_rest(), stride.is_some()) {
+                LINK.request_sleep(SleepPolicy::sleep_after(*samples, QUEUE_LEN), SLEEP.wake);
+            }
         }
-        Item::Gap(_) => {}
+        Item::Asleep => {
+            log.asleep(policy.still_samples(), &SLEEP, serial);
+            policy.reset();
+        }
+        Item::Gap(_) | Item::Woke(_) => policy.reset(),
     }
     // A stride a gap hands back was closed before it: it comes first.
     if let Some(stride) = &stride {
         log.stride(stride, serial);
     }
-    if let Item::Gap(n) = item {
-        log.gap(n, pipeline.hole_kind(n), serial);
+    match item {
+        Item::Gap(n) => log.gap(n, pipeline.hole_kind(n), serial),
+        Item::Woke(n) => log.woke(n, serial),
+        _ => {}
     }
 }
 
@@ -201,8 +240,8 @@ fn finish<D: StepDetector>(pipeline: &mut Pipeline<D>, log: &mut StrideLog, samp
 }
 
 /// The body of the board's `DefaultHandler`: for the timer's interrupt, one data-ready
-/// pulse of the emulated sensor, or, once the trace has been served, the end of the run (the
-/// timer stops).
+/// pulse of the emulated sensor (or, while it sleeps, one wake-up of its cycle mode), or,
+/// once the trace has been served, the end of the run (the timer stops).
 pub fn on_interrupt<T: SampleTimer>(irqn: i16) {
     if irqn == T::IRQ as i16 {
         // Note(unsafe): the handler only acknowledges and stops the timer (`steal`).
@@ -210,14 +249,51 @@ pub fn on_interrupt<T: SampleTimer>(irqn: i16) {
     }
 }
 
+/// What a timer tick did to the emulated sensor.
+enum Tick {
+    /// Sampled (or slept on): the timer goes on as it is.
+    Same,
+    /// The sensor went to sleep: the timer ticks at its wake rate.
+    FellAsleep,
+    /// It woke on motion: the timer pulses at the sample rate again.
+    Woke,
+    /// The trace is over.
+    Done,
+}
+
 fn on_timer_interrupt(timer: &impl SampleTimer) {
     timer.clear_interrupt();
-    if LINK.pulses() >= TRACE_SAMPLES {
-        TRACE_DONE.store(true, Ordering::Release);
-        timer.stop();
-        return;
+    let tick = LINK.with_sampler(|s, mut push| {
+        if s.asleep() {
+            return match s.bus_mut().wake_tick() {
+                WakeTick::Motion => {
+                    let slept = s.bus_mut().periods_in_cycle();
+                    s.on_motion(slept, SETTLE, &mut push);
+                    Tick::Woke
+                }
+                WakeTick::Ended => Tick::Done,
+                WakeTick::Still | WakeTick::Awake => Tick::Same,
+            };
+        }
+        if s.bus_mut().remaining() == 0 {
+            return Tick::Done;
+        }
+        s.on_data_ready(&mut push);
+        if s.asleep() {
+            Tick::FellAsleep
+        } else {
+            Tick::Same
+        }
+    });
+    match tick {
+        Some(Tick::Done) => {
+            TRACE_DONE.store(true, Ordering::Release);
+            timer.stop();
+        }
+        Some(Tick::FellAsleep) => timer.start_periodic(SLEEP.wake.rate.millihertz()),
+        Some(Tick::Woke) => timer.start_periodic(trace::RATE_MILLIHERTZ),
+        Some(Tick::Same) | None => {}
     }
-    LINK.on_data_ready();
 }
 
 #[cortex_m_rt::exception]

@@ -12,12 +12,13 @@
 //! serial/defmt log does not depend on any of it.
 
 use core::cell::RefCell;
-use core::sync::atomic::{AtomicU32, AtomicU8, Ordering};
+use core::sync::atomic::{AtomicBool, AtomicU32, AtomicU8, Ordering};
 
 use embassy_futures::select::{select, Either};
 use embassy_sync::blocking_mutex::raw::CriticalSectionRawMutex;
 use embassy_sync::blocking_mutex::Mutex;
 use embassy_sync::channel::Channel;
+use embassy_sync::signal::Signal;
 use embassy_time::{Duration, Instant, Timer};
 use gaitclip::stride::Stride;
 use trouble_host::prelude::*;
@@ -42,6 +43,9 @@ pub const L2CAP_CHANNELS_MAX: usize = 2;
 /// Advertising interval while waiting for a central, ms (152.5 ms: the interval Apple's
 /// accessory guidelines recommend for a fast discovery).
 pub const ADVERTISING_INTERVAL_MS: u64 = 152;
+/// Advertising interval while the clip sleeps, ms (1022.5 ms, the longest of the intervals
+/// the same guidelines list): a watch still finds it, at a seventh of the radio's duty.
+pub const SLEEPING_ADVERTISING_INTERVAL_MS: u64 = 1022;
 /// The name in the advertising data and the GAP service.
 pub const DEVICE_NAME: &str = "gaitclip";
 
@@ -155,6 +159,10 @@ pub struct PodLink {
     notified: AtomicU32,
     /// Connections so far.
     connections: AtomicU32,
+    /// The clip sleeps ([`crate::sleep`]): advertise slowly.
+    asleep: AtomicBool,
+    /// Raised when `asleep` changes, to restart advertising at the other interval.
+    asleep_changed: Signal<CriticalSectionRawMutex, ()>,
 }
 
 impl Default for PodLink {
@@ -173,6 +181,25 @@ impl PodLink {
             unqueued: AtomicU32::new(0),
             notified: AtomicU32::new(0),
             connections: AtomicU32::new(0),
+            asleep: AtomicBool::new(false),
+            asleep_changed: Signal::new(),
+        }
+    }
+
+    /// The clip went to sleep or woke: advertising restarts at
+    /// [`SLEEPING_ADVERTISING_INTERVAL_MS`] or [`ADVERTISING_INTERVAL_MS`] (a connection
+    /// already made is kept either way).
+    pub fn set_asleep(&self, asleep: bool) {
+        if self.asleep.swap(asleep, Ordering::Relaxed) != asleep {
+            self.asleep_changed.signal(());
+        }
+    }
+
+    fn advertising_interval_ms(&self) -> u64 {
+        if self.asleep.load(Ordering::Relaxed) {
+            SLEEPING_ADVERTISING_INTERVAL_MS
+        } else {
+            ADVERTISING_INTERVAL_MS
         }
     }
 
@@ -240,7 +267,18 @@ pub async fn run<C: Controller>(controller: C, address: Address, link: &PodLink)
     };
     let app = async {
         loop {
-            match advertise(&mut peripheral, &server).await {
+            link.asleep_changed.reset();
+            let interval = link.advertising_interval_ms();
+            let advertised = select(
+                advertise(&mut peripheral, &server, interval),
+                link.asleep_changed.wait(),
+            )
+            .await;
+            let Either::First(advertised) = advertised else {
+                // Asleep or awake now: advertise again at the other interval.
+                continue;
+            };
+            match advertised {
                 Ok(conn) => {
                     link.connections.fetch_add(1, Ordering::Relaxed);
                     ble_log!(info, "BLE: central connected");
@@ -283,12 +321,13 @@ fn fail(what: &str, e: impl core::fmt::Debug) -> ! {
 async fn advertise<'values, 'server, C: Controller>(
     peripheral: &mut Peripheral<'values, C, DefaultPacketPool>,
     server: &'server FootPodServer<'values>,
+    interval_ms: u64,
 ) -> Result<GattConnection<'values, 'server, DefaultPacketPool>, BleHostError<C::Error>> {
     let mut adv = [0u8; 31];
     let len = advertising_data(&mut adv)?;
     let params = AdvertisementParameters {
-        interval_min: Duration::from_millis(ADVERTISING_INTERVAL_MS),
-        interval_max: Duration::from_millis(ADVERTISING_INTERVAL_MS),
+        interval_min: Duration::from_millis(interval_ms),
+        interval_max: Duration::from_millis(interval_ms),
         ..Default::default()
     };
     let advertiser = peripheral

@@ -11,7 +11,9 @@
 //! # still: gyro_bias_mdps=-1220,305,61 gravity_mg=1003
 //! 0,5120,1362,1105,420,150,380,155,3,4,1,725,380,656,1233,109,131,-215,unknown
 //! # hole samples=12 filled: a stride whose movement it falls in is a gap stride (flag 64), without a length
-//! # status samples=24000 strides=96 distance_mm=131012 bus_errors=0 restarts=0 fifo_overflows=0 silences=0 overruns=0 lost_samples=0
+//! # status samples=24000 strides=96 distance_mm=131012 bus_errors=0 restarts=0 fifo_overflows=0 silences=0 overruns=0 lost_samples=0 sleeps=0 slept_periods=0
+//! # sleep still_ms=10000 wake_mhz=5000 sensor_ua=20: waiting for motion
+//! # wake unsampled_ms=2310 detection restarts: a step the wake-up cut into is a gap stride (flag 64)
 //! ```
 //!
 //! `index` counts strides from 0; `t_ms` is the start of the stride since power-up;
@@ -105,7 +107,7 @@ pub fn status(
 ) -> fmt::Result {
     write!(
         out,
-        "# status samples={} strides={} distance_mm={} bus_errors={} restarts={} fifo_overflows={} silences={} overruns={} lost_samples={}\r\n",
+        "# status samples={} strides={} distance_mm={} bus_errors={} restarts={} fifo_overflows={} silences={} overruns={} lost_samples={} sleeps={} slept_periods={}\r\n",
         samples,
         strides,
         distance_mm,
@@ -114,6 +116,8 @@ pub fn status(
         c.fifo_overflows,
         c.silences,
         c.overruns,
-        c.lost_samples
+        c.lost_samples,
+        c.sleeps,
+        c.slept_periods
     )
 }

@@ -13,6 +13,7 @@ use gaitclip::stride::Stride;
 
 use crate::imu_sampler::Counters;
 use crate::serial_line;
+use crate::sleep::SleepSettings;
 use crate::startup::StartupEvent;
 
 /// A serial output that discards everything (boards without a UART).
@@ -158,10 +159,41 @@ impl StrideLog {
         let _ = serial_line::comment(serial, format_args!("hole samples={} {}", samples, what));
     }
 
+    /// Reports that the sensor went to its low-power wait for motion, still for
+    /// `still_samples` samples.
+    pub fn asleep(&self, still_samples: u32, settings: &SleepSettings, serial: &mut impl Write) {
+        let still_ms = self.rate.ms_of_samples(still_samples);
+        let wake = settings.wake.rate;
+        defmt::info!(
+            "sleep: still for {=u32} ms; sensor waits for motion at {=u32} mHz ({=u32} uA), MCU sleeps",
+            still_ms,
+            wake.millihertz(),
+            wake.supply_ua()
+        );
+        let _ = serial_line::comment(
+            serial,
+            format_args!(
+                "sleep still_ms={} wake_mhz={} sensor_ua={}: waiting for motion",
+                still_ms,
+                wake.millihertz(),
+                wake.supply_ua()
+            ),
+        );
+    }
+
+    /// Reports the wake-up on motion: `periods` sample periods were not sampled (asleep,
+    /// then the gyro's settling).
+    pub fn woke(&self, periods: u32, serial: &mut impl Write) {
+        let ms = self.rate.ms_of_samples(periods);
+        let what = "detection restarts: a step the wake-up cut into is a gap stride (flag 64)";
+        defmt::info!("wake: motion after {=u32} ms unsampled; {=str}", ms, what);
+        let _ = serial_line::comment(serial, format_args!("wake unsampled_ms={} {}", ms, what));
+    }
+
     /// Logs the status (periodically, and at the end of a run).
     pub fn summary(&self, samples: u32, c: &Counters, serial: &mut impl Write) {
         defmt::println!(
-            "summary strides={=u32} distance_mm={=u64} samples={=u32} overruns={=u32} bus_errors={=u32} restarts={=u32} fifo_overflows={=u32} silences={=u32} lost_samples={=u32}",
+            "summary strides={=u32} distance_mm={=u64} samples={=u32} overruns={=u32} bus_errors={=u32} restarts={=u32} fifo_overflows={=u32} silences={=u32} lost_samples={=u32} sleeps={=u32} slept_periods={=u32}",
             self.strides,
             self.distance_mm,
             samples,
@@ -170,7 +202,9 @@ impl StrideLog {
             c.restarts,
             c.fifo_overflows,
             c.silences,
-            c.lost_samples
+            c.lost_samples,
+            c.sleeps,
+            c.slept_periods
         );
         let _ = serial_line::status(serial, samples, self.strides, self.distance_mm, c);
     }

@@ -1,0 +1,185 @@
+//! Sleeping when still and waking on motion, on the host: the policy's still count, the
+//! sampler's way into the sensor's cycle mode and back (over the emulated sensor, the real
+//! driver on top), and the emulated part's wake-ups and motion test.
+
+use embedded_hal_mock::eh1::delay::NoopDelay;
+use gaitclip::mpu6050::{Address, Config, Mpu6050, OutputRate};
+use gaitclip::rate::SampleRate;
+use gaitclip::sample::RawSample;
+use gaitclip_board::imu_sampler::{ImuSampler, Item, ReadMode};
+use gaitclip_board::replay_mpu6050::{
+    mg_to_counts, motion_between, periods_per_wake, ReplayMpu6050, WakeTick, REPLAY_MOTION_UNIT,
+};
+use gaitclip_board::sleep::{SleepPolicy, SLEEP, WAKE_THRESHOLD_MG};
+
+const RATE: u32 = 200;
+
+#[test]
+fn the_policy_sleeps_after_ten_still_seconds_and_again_after_each_more() {
+    let rate = SampleRate::from_hz(RATE).unwrap();
+    let mut p = SleepPolicy::new(rate, &SLEEP);
+    // Still for 9.995 s, then a stride: nothing, and the count starts over.
+    assert!((0..1999).all(|_| !p.after_sample(true, false)));
+    assert!(!p.after_sample(true, true));
+    assert_eq!(p.still_samples(), 0);
+    // A moving sample resets it too.
+    assert!((0..1000).all(|_| !p.after_sample(true, false)));
+    assert!(!p.after_sample(false, false));
+    // 10 s still: a sleep is due at the 2000th sample, and again at the 4000th (the first
+    // failed on the bus, say).
+    let due: Vec<usize> = (1..=4000).filter(|_| p.after_sample(true, false)).collect();
+    assert_eq!(due.len(), 2);
+    let mut p = SleepPolicy::new(rate, &SLEEP);
+    let first = (1..=4000u32).find(|_| p.after_sample(true, false));
+    assert_eq!(first, Some(2000));
+    // Past anything a queue of 32 can hold, and the gyro's 30 ms.
+    assert_eq!(SleepPolicy::sleep_after(2000, 32), 2033);
+    assert_eq!(SleepPolicy::settle_samples(rate, &SLEEP), 6);
+}
+
+#[test]
+fn the_wake_threshold_is_three_counts_of_the_32_mg_unit() {
+    assert_eq!(WAKE_THRESHOLD_MG, 96);
+    assert_eq!(SLEEP.wake.threshold.counts(), 3);
+    assert_eq!(SLEEP.wake.threshold.mg(REPLAY_MOTION_UNIT), 96);
+    // ±16 g: 2048 counts per g, 96 mg = 196 counts.
+    assert_eq!(mg_to_counts(96, 3), 196);
+    assert_eq!(mg_to_counts(1000, 0), 16_384);
+    // Any axis, either sign, strictly more than the threshold.
+    assert!(!motion_between([0, 0, 2048], [196, -196, 2048 + 196], 196));
+    assert!(motion_between([0, 0, 2048], [0, -197, 2048], 196));
+    assert!(motion_between([0, 0, 2048], [0, 0, 2048 + 197], 196));
+    assert_eq!(periods_per_wake(200_000, 1), 40);
+    assert_eq!(periods_per_wake(200_000, 0), 160);
+    assert_eq!(periods_per_wake(100_000, 3), 2);
+}
+
+/// 100 samples: still (gravity on z) for 90, then the clip tilts.
+fn trace_bytes() -> &'static [u8] {
+    let mut v = Vec::new();
+    for k in 0..100i16 {
+        let ax: i16 = if k < 90 { 10 } else { 1200 };
+        let s = RawSample {
+            accel: [ax, -20, 2048],
+            temp: 0,
+            gyro: [k, 0, 0],
+        };
+        v.extend_from_slice(&s.to_be_bytes());
+    }
+    v.leak()
+}
+
+#[test]
+fn the_emulated_sensor_holds_still_runs_and_maps_periods_to_samples() {
+    static STILL: [(u32, u32); 2] = [(3, 5), (10, 2)];
+    let s = ReplayMpu6050::with_still(0x68, trace_bytes(), 200_000, &STILL, &[]);
+    assert_eq!(s.periods(), 107);
+    let map: Vec<Option<usize>> = (0..16).map(|p| s.sample_at(p)).collect();
+    let want = [0, 1, 2, 3, 3, 3, 3, 3, 3, 4, 5, 6, 7, 8, 9, 10];
+    assert_eq!(map, want.map(Some));
+    assert_eq!(s.sample_at(16), Some(10));
+    assert_eq!(s.sample_at(17), Some(10));
+    assert_eq!(s.sample_at(18), Some(11));
+    assert_eq!(s.sample_at(106), Some(99));
+    assert_eq!(s.sample_at(107), None);
+}
+
+fn push_into(items: &mut Vec<Item>) -> impl FnMut(Item) -> bool + '_ {
+    |i| {
+        items.push(i);
+        true
+    }
+}
+
+#[test]
+fn the_sampler_sleeps_wakes_on_motion_and_declares_what_it_did_not_sample() {
+    let bus = ReplayMpu6050::with_still(0x68, trace_bytes(), 200_000, &[], &[]);
+    let config = Config::new(OutputRate::from_hz(200).unwrap());
+    let Ok(mut s) = ImuSampler::start(
+        Mpu6050::new(bus, Address::Ad0Low),
+        NoopDelay,
+        config,
+        ReadMode::PerSample,
+    ) else {
+        panic!("the sensor starts");
+    };
+    let mut items = Vec::new();
+    // The main loop asks for a sleep after 12 samples (say 10 processed, 1 queued, queue 1).
+    s.request_sleep(12, SLEEP.wake);
+    for _ in 0..20 {
+        s.on_data_ready(&mut push_into(&mut items));
+    }
+    // Twelve samples, then the sensor sleeps; the pulses after it read nothing.
+    assert_eq!(items.len(), 13);
+    assert!(items[..12].iter().all(|i| matches!(i, Item::Sample(_))));
+    assert_eq!(items[12], Item::Asleep);
+    assert!(s.asleep());
+    assert_eq!(s.counters().sleeps, 1);
+    // The cycle mode's wake-ups: every 40 periods (5 Hz at 200 Hz) on the sensor's clock,
+    // at 40 and 80 still; the one at 120 is past the recording's 100 samples: it ended
+    // asleep (the tilt at 90 fell between wake-ups).
+    assert_eq!(s.bus_mut().wake_tick(), WakeTick::Still); // period 40
+    assert_eq!(s.bus_mut().position(), 41);
+    assert_eq!(s.bus_mut().wake_tick(), WakeTick::Still); // period 80
+    assert_eq!(s.bus_mut().wake_tick(), WakeTick::Ended); // period 120: past the end
+}
+
+#[test]
+fn a_tilt_wakes_the_sensor_and_full_sampling_resumes_after_the_gyro_settles() {
+    // 200 samples: still to 90, tilted after.
+    let mut v = Vec::new();
+    for k in 0..200i16 {
+        let ax: i16 = if k < 90 { 10 } else { 1200 };
+        let s = RawSample {
+            accel: [ax, -20, 2048],
+            temp: 0,
+            gyro: [k, 0, 0],
+        };
+        v.extend_from_slice(&s.to_be_bytes());
+    }
+    let bus = ReplayMpu6050::with_still(0x68, v.leak(), 200_000, &[], &[]);
+    let config = Config::new(OutputRate::from_hz(200).unwrap());
+    let Ok(mut s) = ImuSampler::start(
+        Mpu6050::new(bus, Address::Ad0Low),
+        NoopDelay,
+        config,
+        ReadMode::PerSample,
+    ) else {
+        panic!("the sensor starts");
+    };
+    let mut items = Vec::new();
+    s.request_sleep(10, SLEEP.wake);
+    for _ in 0..10 {
+        s.on_data_ready(&mut push_into(&mut items));
+    }
+    assert!(s.asleep());
+    // Wake-ups at periods 40 and 80 see the still clip; at 120 the tilt (sample 120 against
+    // sample 80: 1190 counts on x, over the 196 of 96 mg).
+    let ticks: Vec<WakeTick> = (0..3).map(|_| s.bus_mut().wake_tick()).collect();
+    assert_eq!(ticks, [WakeTick::Still, WakeTick::Still, WakeTick::Motion]);
+    let slept = s.bus_mut().periods_in_cycle();
+    assert_eq!(slept, 111, "periods 10..=120 went unsampled");
+    items.clear();
+    s.on_motion(slept, 6, &mut push_into(&mut items));
+    assert!(!s.asleep());
+    assert!(items.is_empty(), "nothing before the first sample kept");
+    for _ in 0..8 {
+        s.on_data_ready(&mut push_into(&mut items));
+    }
+    // Six samples dropped while the gyro settles (121..=126), then one hole for all of it,
+    // then samples from 127 on (the gyro x counts number the samples).
+    assert_eq!(items[0], Item::Woke(117));
+    let Item::Sample(first) = items[1] else {
+        panic!("{:?}", items[1]);
+    };
+    assert_eq!(first.gyro[0], 127);
+    assert_eq!(items.len(), 3);
+    let c = s.counters();
+    assert_eq!((c.sleeps, c.slept_periods, c.lost_samples), (1, 117, 0));
+    // The motion latch was read and cleared on the way back.
+    assert_eq!(
+        s.bus_mut().wake_tick(),
+        WakeTick::Awake,
+        "out of cycle mode, no wake-ups"
+    );
+}
