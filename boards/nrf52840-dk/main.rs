@@ -109,7 +109,9 @@ static SLEEP_CLOCK: Mutex<RefCell<Option<SleepClock>>> = Mutex::new(RefCell::new
 const SLEEP_CLOCK_HZ: u32 = 8;
 /// Samples dropped after a wake-up while the gyro settles.
 const SETTLE: u32 = SleepPolicy::settle_samples(RATE, &SLEEP);
-static GPIOTE: Mutex<RefCell<Option<Gpiote>>> = Mutex::new(RefCell::new(None));
+/// GPIOTE and the INT pin it watches.
+static GPIOTE: Mutex<RefCell<Option<(Gpiote, IntPin)>>> = Mutex::new(RefCell::new(None));
+type IntPin = Pin<Input<Floating>>;
 /// TIMER1, ticking the watchdog.
 type WatchdogTimer = Timer<TIMER1, Periodic>;
 static WATCHDOG: Mutex<RefCell<Option<(WatchdogTimer, Watchdog)>>> = Mutex::new(RefCell::new(None));
@@ -174,7 +176,7 @@ fn main() -> ! {
     timer.enable_interrupt();
     timer.start(WATCHDOG_TICK_MS * 1000); // 1 MHz timer clock
     irq::free(|cs| {
-        GPIOTE.borrow(cs).replace(Some(gpiote));
+        GPIOTE.borrow(cs).replace(Some((gpiote, int_pin)));
         WATCHDOG.borrow(cs).replace(Some((timer, Watchdog::new())));
         SLEEP_CLOCK.borrow(cs).replace(Some((rtc, 0)));
     });
@@ -191,8 +193,8 @@ fn main() -> ! {
 #[interrupt]
 fn GPIOTE() {
     irq::free(|cs| {
-        if let Some(g) = GPIOTE.borrow(cs).borrow().as_ref() {
-            g.channel0().reset_events();
+        if let Some((g, _)) = GPIOTE.borrow(cs).borrow().as_ref() {
+            g.reset_events();
         }
     });
     irq::free(|cs| {
@@ -212,11 +214,40 @@ fn GPIOTE() {
             IntEvent::FellAsleep => {
                 *asleep_at = now;
                 set_awake_clocks(cs, false);
+                watch_int(cs, false);
             }
-            IntEvent::Woke => set_awake_clocks(cs, true),
+            IntEvent::Woke => {
+                watch_int(cs, true);
+                set_awake_clocks(cs, true);
+            }
             IntEvent::Sampled => {}
         }
     });
+}
+
+/// Watches INT with channel 0's rising-edge event while sampling (it catches the 50 µs
+/// data-ready pulses), and with the PORT event on the pin's level while asleep: an IN
+/// channel in event mode keeps a high-frequency clock requested, the pin's SENSE does not,
+/// and the latched motion interrupt is a level the SENSE cannot miss.
+fn watch_int(cs: &irq::CriticalSection, sampling: bool) {
+    let gpiote = GPIOTE.borrow(cs).borrow();
+    let Some((g, pin)) = gpiote.as_ref() else {
+        return;
+    };
+    if sampling {
+        g.port().disable_interrupt();
+        g.port().input_pin(pin).disabled();
+        g.channel0().input_pin(pin).lo_to_hi().enable_interrupt();
+    } else {
+        g.channel0().input_pin(pin).none().disable_interrupt();
+        // Note(unsafe): only this handler and `main` (before the interrupts were unmasked)
+        // touch GPIOTE; writing CONFIG[0] is a plain register write, MODE = disabled frees
+        // the channel (the HAL has no call for it).
+        let raw = unsafe { &*pac::GPIOTE::ptr() };
+        raw.config[0].write(|w| w.mode().disabled());
+        g.port().input_pin(pin).high();
+        g.port().enable_interrupt();
+    }
 }
 
 /// Stops (asleep) or starts (awake) what only sampling needs: TIMER1's watchdog ticks and
