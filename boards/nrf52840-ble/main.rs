@@ -348,6 +348,9 @@ fn build_sdc<'d, const N: usize>(
 async fn main(spawner: Spawner) {
     let mut config = embassy_nrf::config::Config::default();
     // Below the SoftDevice Controller's 0 and 1.
+    // The DK has the DC/DC converter's inductor: the core and radio draw about half the
+    // LDO's current through it (PS v1.11 §5.2). A clip board without it must leave this out.
+    config.dcdc.reg1 = true;
     config.gpiote_interrupt_priority = Priority::P2;
     config.time_interrupt_priority = Priority::P2;
     let p = embassy_nrf::init(config);

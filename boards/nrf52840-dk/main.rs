@@ -125,6 +125,10 @@ fn main() -> ! {
     let Some(p) = pac::Peripherals::take() else {
         panic!("peripherals taken twice");
     };
+    // The DK has the DC/DC converter's inductor: the core and radio draw about half the
+    // LDO's current through it (PS v1.11 §5.2: 3.3 against 6.3 mA at 64 MHz). A clip board
+    // without the inductor must leave this out.
+    p.POWER.dcdcen.write(|w| w.dcdcen().enabled());
     let _clocks = hal::clocks::Clocks::new(p.CLOCK)
         .enable_ext_hfosc()
         .set_lfclk_src_rc()
