@@ -6,7 +6,8 @@
 //!   of every call of the functions named in [`MEASURED`];
 //! * flash, static RAM and the stack's high-water mark of every firmware build;
 //! * host replay throughput (the criterion benchmark `benches/replay.rs`) next to gaitmap's
-//!   pipeline on the same trace (`tests-host/gaitmap/`).
+//!   pipeline on the same trace (`tests-host/gaitmap/`);
+//! * the energy budget of the real boards ([`crate::energy`]) from the instruction counts.
 //!
 //! The counting runs are [`crate::insn_count`]; this module builds the firmware, measures
 //! sizes and stacks, and writes the report.
@@ -522,5 +523,10 @@ fn render(r: &Report) -> String {
         "| host replay ≥ 100× gaitmap | {ratio:.0}× | {} |",
         verdict(ratio >= 100.0)
     );
+    let _ = writeln!(o, "\n### Energy\n");
+    o.push_str(&crate::energy::report(
+        m4.sample_all_mean,
+        m0.sample_all_mean,
+    ));
     o
 }

@@ -9,6 +9,7 @@ pub mod cross_validation;
 pub mod csv_trace;
 pub mod cycle_ref;
 pub mod datasets;
+pub mod energy;
 pub mod eval;
 pub mod firmware;
 pub mod fit;

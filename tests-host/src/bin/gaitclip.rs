@@ -114,6 +114,17 @@ enum Cmd {
         #[arg(long, default_value = "target/cost")]
         scratch: PathBuf,
     },
+    /// Print the energy budget of the real boards (the README's energy tables; `cost`
+    /// prints the same from the instructions it measures) for given instruction counts per
+    /// sample of walking, strides included.
+    Energy {
+        /// Instructions per sample on the Cortex-M4 (the nRF52840 builds).
+        #[arg(long)]
+        m4: f64,
+        /// Instructions per sample on the Cortex-M0 (the Pico build).
+        #[arg(long)]
+        m0: f64,
+    },
     /// Cut holes of 1–16 samples into the walking strides of the datasets with per-stride
     /// references and print what bridging them costs, by hole length (the README's hole
     /// table, and the bridge limit it gives).
@@ -489,6 +500,7 @@ fn run(cli: Cli) -> anyhow::Result<()> {
             })?;
             print!("{report}");
         }
+        Cmd::Energy { m4, m0 } => print!("{}", gaitclip_host::energy::report(m4, m0)),
         Cmd::Holes { datasets } => {
             print!("{}", gaitclip_host::hole_sweep::report(&datasets)?);
         }
