@@ -33,4 +33,5 @@ pub mod stats;
 pub mod tables;
 pub mod trace;
 pub mod train;
+pub mod wake_eval;
 pub mod zupt_sweep;

@@ -125,6 +125,14 @@ enum Cmd {
         #[arg(long)]
         m0: f64,
     },
+    /// Put the sensor to sleep at every stand of the datasets and say when the wake rule
+    /// would wake it: early in the stand, how far into the walk, or not at all (the README's
+    /// wake table).
+    Wake {
+        /// The folder holding the datasets (`../shared/datasets`).
+        #[arg(default_value = "../../shared/datasets")]
+        datasets: PathBuf,
+    },
     /// Cut holes of 1–16 samples into the walking strides of the datasets with per-stride
     /// references and print what bridging them costs, by hole length (the README's hole
     /// table, and the bridge limit it gives).
@@ -501,6 +509,7 @@ fn run(cli: Cli) -> anyhow::Result<()> {
             print!("{report}");
         }
         Cmd::Energy { m4, m0 } => print!("{}", gaitclip_host::energy::report(m4, m0)),
+        Cmd::Wake { datasets } => print!("{}", gaitclip_host::wake_eval::report(&datasets)?.1),
         Cmd::Holes { datasets } => {
             print!("{}", gaitclip_host::hole_sweep::report(&datasets)?);
         }
