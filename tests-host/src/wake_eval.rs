@@ -99,6 +99,15 @@ pub fn evaluate_at(dir: &Path, threshold_mg: u32) -> Result<WakeResult> {
             if moved >= rest.len() || ((moved - start) as f64) < MIN_STAND_S * hz {
                 continue;
             }
+            // Inside the labelled walk (its first stand included), where the dataset says:
+            // not the shuffling after a recording's walk has ended.
+            let t_moved = trace.samples[moved].t_s;
+            let (from_s, to_s) = trial
+                .span_s
+                .unwrap_or((trial.span.0 as f64 / hz, trial.span.1 as f64 / hz));
+            if t_moved < from_s - WALK_WITHIN_S || t_moved > to_s {
+                continue;
+            }
             // A walk, not a shuffle at the end: a stride leaves this stand.
             let near =
                 |i: usize| i + hz as usize >= moved && i <= moved + (WALK_WITHIN_S * hz) as usize;

@@ -264,8 +264,11 @@ fn still_trace(counts: &[RawSample]) -> Vec<RawSample> {
 /// with the wake-up before; on motion the gyro's settling samples are dropped and every
 /// unsampled period declared as one hole. Returns the strides, the samples processed, the
 /// sleeps and the periods slept (those of a sleep that lasted to the end uncounted).
-fn sleeping_host_model(trace: &[RawSample], config: Config) -> (Vec<Stride>, u32, u32, u32) {
-    let mut p = gaitclip::pipeline::Pipeline::new(config);
+fn sleeping_host_model<const M: usize>(
+    trace: &[RawSample],
+    config: Config,
+) -> (Vec<Stride>, u32, u32, u32) {
+    let mut p = gaitclip::pipeline::Pipeline::<gaitclip::detector::AnyDetector<M>>::sized(config);
     let mut policy = SleepPolicy::new(config.rate, &SLEEP);
     let period = (config.rate.millihertz() / SLEEP.wake.rate.millihertz()) as usize;
     let threshold = replay_mpu6050::mg_to_counts(
@@ -321,29 +324,25 @@ fn sleeping_host_model(trace: &[RawSample], config: Config) -> (Vec<Stride>, u32
 /// (`replay_app::QUEUE_LEN`).
 const REPLAY_QUEUE_LEN: usize = 32;
 
-/// The emulated M4 board, its sensor holding still for 12 s in the middle of the demo walk
-/// and 13 s at its end: the firmware sleeps after 10 s still, the sensor's cycle mode wakes it
-/// on the first step, and it sleeps again to the end, logging exactly the strides of the host
-/// model of the same. The step the wake-up cut into is a gap stride; the strides after it
-/// come out as they do in the replay that never slept.
-#[test]
-fn qemu_m4_sleeps_when_still_and_wakes_as_the_host_model() {
+/// The sleep replay (`replay-sleep`) of board `dir` on `machine` against the host model with
+/// the board's movement buffer `M`: the same strides, sleeps, wakes and counts. Returns the
+/// host model's strides and configuration (`None`: no QEMU here, skipped).
+fn sleeps_and_wakes_as_the_host_model<const M: usize>(
+    dir: &str,
+    bin: &str,
+    target: &str,
+    machine: &str,
+) -> Option<(Vec<Stride>, Config)> {
     if !qemu::available_or_skip() {
-        return;
+        return None;
     }
     let env = [("CARGO_TARGET_DIR", "target/replay-sleep".as_ref())];
-    let elf = firmware::build_with(
-        "boards/mps2-an386",
-        "mps2-an386",
-        "thumbv7em-none-eabihf",
-        &["--features", "replay-sleep"],
-        &env,
-    )
-    .expect("firmware builds");
+    let elf = firmware::build_with(dir, bin, target, &["--features", "replay-sleep"], &env)
+        .expect("firmware builds");
     let out = qemu::run(
         &elf,
         &RunOptions {
-            machine: qemu::MACHINE_M4.into(),
+            machine: machine.into(),
             fast: true,
             extra_args: Vec::new(),
         },
@@ -364,7 +363,7 @@ fn qemu_m4_sleeps_when_still_and_wakes_as_the_host_model() {
         ranges.accel.scale(),
         ranges.gyro.scale(),
     );
-    let (host, processed, sleeps, slept) = sleeping_host_model(&still_trace(&counts), config);
+    let (host, processed, sleeps, slept) = sleeping_host_model::<M>(&still_trace(&counts), config);
     let host_logged: Vec<LoggedStride> = host.iter().map(LoggedStride::of).collect();
     assert_eq!(on_target, host_logged);
 
@@ -388,6 +387,25 @@ fn qemu_m4_sleeps_when_still_and_wakes_as_the_host_model() {
         assert!(summary.contains(&field), "{field} not in {summary}");
     }
 
+    Some((host, config))
+}
+
+/// The emulated M4 board, its sensor holding still for 12 s in the middle of the demo walk
+/// and 13 s at its end: the firmware sleeps after 10 s still, the sensor's cycle mode wakes it
+/// on the first step, and it sleeps again to the end, logging exactly the strides of the host
+/// model of the same. The step the wake-up cut into is a gap stride; the strides after it
+/// come out as they do in the replay that never slept.
+#[test]
+fn qemu_m4_sleeps_when_still_and_wakes_as_the_host_model() {
+    let Some((host, config)) = sleeps_and_wakes_as_the_host_model::<1024>(
+        "boards/mps2-an386",
+        "mps2-an386",
+        "thumbv7em-none-eabihf",
+        qemu::MACHINE_M4,
+    ) else {
+        return;
+    };
+    let counts = gaitclip_host::fixtures::firmware_trace_counts().unwrap();
     // The step the wake-up cut into is a gap stride, flagged, not dropped; every stride
     // after it has the length, events and gait of the replay that never slept (its sample
     // indices later by the periods the still runs added), but the first: after a gap it
@@ -424,4 +442,16 @@ fn qemu_m4_sleeps_when_still_and_wakes_as_the_host_model() {
             assert_eq!(s.gait, twin.gait);
         }
     }
+}
+
+/// The same on the emulated M0 (micro:bit, movement buffer of 256), whose stack has the least
+/// to spare: the sleep and wake paths run there too, bit-exact with the host model.
+#[test]
+fn qemu_m0_sleeps_when_still_and_wakes_as_the_host_model() {
+    let _ = sleeps_and_wakes_as_the_host_model::<MICROBIT_MOVEMENT_SAMPLES>(
+        "boards/microbit",
+        "microbit",
+        "thumbv6m-none-eabi",
+        qemu::MACHINE_M0,
+    );
 }

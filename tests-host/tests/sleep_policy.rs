@@ -184,10 +184,10 @@ fn a_tilt_wakes_the_sensor_and_full_sampling_resumes_after_the_gyro_settles() {
     );
 }
 
-/// The wake rule on the real stands of the datasets (`gaitclip wake`): at the firmware's
-/// 96 mg it wakes within one wake period (0.2 s) of the first movement at the median, wakes
-/// early in at most 5 % of the stands, and sleeps through the first second of at most 3 % of
-/// the walks (slow starters whose first motions stay under the threshold).
+/// The wake rule on the real stands of the datasets' labelled walks (`gaitclip wake`): at
+/// the firmware's 96 mg it wakes within one wake period (0.2 s) of the first movement at the
+/// median, early from at most 5 % of the stands, and sleeps through the first second of at
+/// most 1 % of the walks (measured 2026-12-02: 4 early of 200, none slept through).
 #[test]
 fn the_wake_rule_catches_real_walks_and_keeps_still_through_real_stands() {
     let Some(root) = gaitclip_host::datasets::root_or_skip(
@@ -198,7 +198,7 @@ fn the_wake_rule_catches_real_walks_and_keeps_still_through_real_stands() {
     let (results, table) = gaitclip_host::wake_eval::report(&root).unwrap();
     println!("{table}");
     let stands: usize = results.iter().map(|r| r.stands).sum();
-    assert!(stands >= 200, "{stands} stands");
+    assert!(stands >= 150, "{stands} stands");
     for r in &results {
         let mut l = r.latencies_s.clone();
         l.sort_by(f64::total_cmp);
@@ -210,6 +210,6 @@ fn the_wake_rule_catches_real_walks_and_keeps_still_through_real_stands() {
         );
         let share = |n: usize| n as f64 / r.stands as f64;
         assert!(share(r.woke_early) <= 0.05, "{r:?}");
-        assert!(share(r.slept_through) <= 0.03, "{r:?}");
+        assert!(share(r.slept_through) <= 0.01, "{r:?}");
     }
 }
