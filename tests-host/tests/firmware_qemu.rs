@@ -18,6 +18,28 @@ use gaitclip_host::trace::Ranges;
 /// The movement buffer of the micro:bit firmware (`boards/microbit/main.rs`).
 const MICROBIT_MOVEMENT_SAMPLES: usize = 256;
 
+/// Runs a replay firmware in QEMU (virtual time) to its exit, which must be status 0; its
+/// log and the strides it logged.
+fn run_to_exit(elf: &std::path::Path, machine: &str) -> (qemu::RunOutput, Vec<LoggedStride>) {
+    let out = qemu::run(
+        elf,
+        &RunOptions {
+            machine: machine.into(),
+            fast: true,
+            extra_args: Vec::new(),
+        },
+        |_| {},
+    )
+    .expect("qemu runs");
+    assert_eq!(out.status, 0, "log:\n{}", out.lines.join("\n"));
+    let strides = out
+        .lines
+        .iter()
+        .filter_map(|l| parse_stride_line(l))
+        .collect();
+    (out, strides)
+}
+
 fn logged(s: &Stride) -> LoggedStride {
     LoggedStride::of(s)
 }
@@ -40,22 +62,7 @@ fn qemu_m0_bridges_holes_as_the_host_replay() {
         &env,
     )
     .expect("firmware builds");
-    let out = qemu::run(
-        &elf,
-        &RunOptions {
-            machine: qemu::MACHINE_M0.into(),
-            fast: true,
-            extra_args: Vec::new(),
-        },
-        |_| {},
-    )
-    .expect("qemu runs");
-    assert_eq!(out.status, 0, "log:\n{}", out.lines.join("\n"));
-    let on_target: Vec<LoggedStride> = out
-        .lines
-        .iter()
-        .filter_map(|l| parse_stride_line(l))
-        .collect();
+    let (out, on_target) = run_to_exit(&elf, qemu::MACHINE_M0);
 
     // The host: the same counts without the lost samples, each run declared as a gap.
     let all = gaitclip_host::fixtures::firmware_trace_counts().unwrap();
@@ -182,27 +189,7 @@ fn strides_equal_host_replay(
         return;
     }
     let elf = firmware::build_for(dir, bin, target, detector, &[]).expect("firmware builds");
-    let out = qemu::run(
-        &elf,
-        &RunOptions {
-            machine: machine.into(),
-            fast: true,
-            extra_args: Vec::new(),
-        },
-        |_| {},
-    )
-    .expect("qemu runs");
-    assert_eq!(
-        out.status,
-        0,
-        "firmware exit status; log:\n{}",
-        out.lines.join("\n")
-    );
-    let on_target: Vec<LoggedStride> = out
-        .lines
-        .iter()
-        .filter_map(|l| parse_stride_line(l))
-        .collect();
+    let (out, on_target) = run_to_exit(&elf, machine);
 
     let counts = gaitclip_host::fixtures::firmware_trace_counts().unwrap();
     let ranges = Ranges::default();
@@ -339,22 +326,7 @@ fn sleeps_and_wakes_as_the_host_model<const M: usize>(
     let env = [("CARGO_TARGET_DIR", "target/replay-sleep".as_ref())];
     let elf = firmware::build_with(dir, bin, target, &["--features", "replay-sleep"], &env)
         .expect("firmware builds");
-    let out = qemu::run(
-        &elf,
-        &RunOptions {
-            machine: machine.into(),
-            fast: true,
-            extra_args: Vec::new(),
-        },
-        |_| {},
-    )
-    .expect("qemu runs");
-    assert_eq!(out.status, 0, "log:\n{}", out.lines.join("\n"));
-    let on_target: Vec<LoggedStride> = out
-        .lines
-        .iter()
-        .filter_map(|l| parse_stride_line(l))
-        .collect();
+    let (out, on_target) = run_to_exit(&elf, machine);
 
     let counts = gaitclip_host::fixtures::firmware_trace_counts().unwrap();
     let ranges = Ranges::default();

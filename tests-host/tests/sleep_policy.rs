@@ -54,10 +54,10 @@ fn the_wake_threshold_is_three_counts_of_the_32_mg_unit() {
     assert_eq!(periods_per_wake(100_000, 3), 2);
 }
 
-/// 100 samples: still (gravity on z) for 90, then the clip tilts.
-fn trace_bytes() -> &'static [u8] {
+/// `n` samples: still (gravity on z) for 90, then the clip tilts; gyro x numbers them.
+fn trace_of(n: i16) -> &'static [u8] {
     let mut v = Vec::new();
-    for k in 0..100i16 {
+    for k in 0..n {
         let ax: i16 = if k < 90 { 10 } else { 1200 };
         let s = RawSample {
             accel: [ax, -20, 2048],
@@ -67,6 +67,25 @@ fn trace_bytes() -> &'static [u8] {
         v.extend_from_slice(&s.to_be_bytes());
     }
     v.leak()
+}
+
+fn trace_bytes() -> &'static [u8] {
+    trace_of(100)
+}
+
+/// The sampler on the emulated sensor serving `trace`, per-sample reads at 200 Hz.
+fn sampler_on(trace: &'static [u8]) -> ImuSampler<ReplayMpu6050, NoopDelay> {
+    let bus = ReplayMpu6050::with_still(0x68, trace, 200_000, &[], &[]);
+    let config = Config::new(OutputRate::from_hz(200).unwrap());
+    match ImuSampler::start(
+        Mpu6050::new(bus, Address::Ad0Low),
+        NoopDelay,
+        config,
+        ReadMode::PerSample,
+    ) {
+        Ok(s) => s,
+        Err(_) => panic!("the sensor starts"),
+    }
 }
 
 #[test]
@@ -93,16 +112,7 @@ fn push_into(items: &mut Vec<Item>) -> impl FnMut(Item) -> bool + '_ {
 
 #[test]
 fn the_sampler_sleeps_wakes_on_motion_and_declares_what_it_did_not_sample() {
-    let bus = ReplayMpu6050::with_still(0x68, trace_bytes(), 200_000, &[], &[]);
-    let config = Config::new(OutputRate::from_hz(200).unwrap());
-    let Ok(mut s) = ImuSampler::start(
-        Mpu6050::new(bus, Address::Ad0Low),
-        NoopDelay,
-        config,
-        ReadMode::PerSample,
-    ) else {
-        panic!("the sensor starts");
-    };
+    let mut s = sampler_on(trace_bytes());
     let mut items = Vec::new();
     // The main loop asks for a sleep after 12 samples (say 10 processed, 1 queued, queue 1).
     s.request_sleep(12, SLEEP.wake);
@@ -127,26 +137,7 @@ fn the_sampler_sleeps_wakes_on_motion_and_declares_what_it_did_not_sample() {
 #[test]
 fn a_tilt_wakes_the_sensor_and_full_sampling_resumes_after_the_gyro_settles() {
     // 200 samples: still to 90, tilted after.
-    let mut v = Vec::new();
-    for k in 0..200i16 {
-        let ax: i16 = if k < 90 { 10 } else { 1200 };
-        let s = RawSample {
-            accel: [ax, -20, 2048],
-            temp: 0,
-            gyro: [k, 0, 0],
-        };
-        v.extend_from_slice(&s.to_be_bytes());
-    }
-    let bus = ReplayMpu6050::with_still(0x68, v.leak(), 200_000, &[], &[]);
-    let config = Config::new(OutputRate::from_hz(200).unwrap());
-    let Ok(mut s) = ImuSampler::start(
-        Mpu6050::new(bus, Address::Ad0Low),
-        NoopDelay,
-        config,
-        ReadMode::PerSample,
-    ) else {
-        panic!("the sensor starts");
-    };
+    let mut s = sampler_on(trace_of(200));
     let mut items = Vec::new();
     s.request_sleep(10, SLEEP.wake);
     for _ in 0..10 {
