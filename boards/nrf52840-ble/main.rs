@@ -33,12 +33,12 @@ use core::fmt::Write;
 use defmt_rtt as _;
 use embassy_executor::{InterruptExecutor, Spawner};
 use embassy_futures::select::{select3, Either3};
-use embassy_nrf::gpio::Pull;
+use embassy_nrf::gpio::{Input, Pull};
 use embassy_nrf::gpiote::{InputChannel, InputChannelPolarity};
 use embassy_nrf::interrupt::{self, InterruptExt, Priority};
 use embassy_nrf::mode::Async;
-use embassy_nrf::peripherals::{RNG, TWISPI0, UARTE0};
-use embassy_nrf::{bind_interrupts, pac, rng, saadc, twim, uarte};
+use embassy_nrf::peripherals::{self, RNG, TWISPI0, UARTE0};
+use embassy_nrf::{bind_interrupts, pac, rng, saadc, twim, uarte, Peri};
 use embassy_sync::blocking_mutex::raw::CriticalSectionRawMutex;
 use embassy_sync::blocking_mutex::Mutex;
 use embassy_sync::signal::Signal;
@@ -201,52 +201,70 @@ async fn mpsl_task(mpsl: &'static MultiprotocolServiceLayer<'static>) -> ! {
     mpsl.run().await
 }
 
-/// The sampler: a FIFO burst every [`FIFO_BATCH`] pulses of INT, and the sensor watchdog;
-/// while the sensor waits for motion ([`gaitclip_board::sleep`]), only INT, with no
-/// watchdog ticks, the slept periods timed on embassy's RTC time base.
+/// The sampler: a FIFO burst every [`FIFO_BATCH`] pulses of INT (GPIOTE channel 0's rising
+/// edge, which catches the 50 µs pulses), and the sensor watchdog. While the sensor waits
+/// for motion ([`gaitclip_board::sleep`]) the channel is released and INT is watched by the
+/// pin's SENSE (the PORT event: no high-frequency clock requested; the latched motion
+/// interrupt is a level it cannot miss), with no watchdog ticks; the sleep is timed on
+/// embassy's RTC time base.
 #[embassy_executor::task]
 async fn sampler_task(
     mut sampler: ImuSampler<Bus, SpinDelay>,
     mut producer: Producer<'static, Item>,
-    mut int: InputChannel<'static>,
+    mut channel: Peri<'static, peripherals::GPIOTE_CH0>,
+    mut int_pin: Peri<'static, peripherals::P0_03>,
 ) -> ! {
     let mut ticker = Ticker::every(Duration::from_millis(WATCHDOG_TICK_MS as u64));
     let mut watchdog = Watchdog::new();
     let mut pulses = 0u32;
-    let mut asleep_since = Instant::now();
     let mut push = |item| producer.enqueue(item).is_ok();
     loop {
-        if sampler.asleep() {
-            int.wait().await;
-            let slept_us = Instant::now().duration_since(asleep_since).as_micros();
-            let slept = (slept_us * RATE.millihertz() as u64 / 1_000_000_000) as u32;
-            sampler.on_motion(slept, SETTLE, &mut push);
-            watchdog = Watchdog::new();
-            ticker.reset();
-            POD.set_asleep(false);
-        } else {
-            match select3(int.wait(), ticker.next(), SLEEP_REQUEST.wait()).await {
-                Either3::First(()) => {
-                    pulses = pulses.wrapping_add(1);
-                    sampler.on_data_ready(&mut push);
-                }
-                Either3::Second(()) => {
-                    if let Some(lost) = watchdog.tick(pulses, RATE.samples_in_ms(WATCHDOG_TICK_MS))
-                    {
-                        sampler.on_silence(lost, &mut push);
+        {
+            let mut int = InputChannel::new(
+                channel.reborrow(),
+                int_pin.reborrow(),
+                Pull::None,
+                InputChannelPolarity::LoToHi,
+            );
+            while !sampler.asleep() {
+                match select3(int.wait(), ticker.next(), SLEEP_REQUEST.wait()).await {
+                    Either3::First(()) => {
+                        pulses = pulses.wrapping_add(1);
+                        sampler.on_data_ready(&mut push);
                     }
+                    Either3::Second(()) => {
+                        if let Some(lost) =
+                            watchdog.tick(pulses, RATE.samples_in_ms(WATCHDOG_TICK_MS))
+                        {
+                            sampler.on_silence(lost, &mut push);
+                        }
+                    }
+                    Either3::Third(after) => sampler.request_sleep(after, SLEEP.wake),
                 }
-                Either3::Third(after) => sampler.request_sleep(after, SLEEP.wake),
+                publish(&sampler);
             }
-            if sampler.asleep() {
-                asleep_since = Instant::now();
-                POD.set_asleep(true);
-            }
+            // Dropping the channel disables it.
         }
-        let c = sampler.counters();
-        COUNTERS.lock(|cell| cell.set(c));
-        QUEUED.signal(());
+        let asleep_since = Instant::now();
+        POD.set_asleep(true);
+        Input::new(int_pin.reborrow(), Pull::None)
+            .wait_for_high()
+            .await;
+        let slept_us = Instant::now().duration_since(asleep_since).as_micros();
+        let slept = (slept_us * RATE.millihertz() as u64 / 1_000_000_000) as u32;
+        sampler.on_motion(slept, SETTLE, &mut push);
+        watchdog = Watchdog::new();
+        ticker.reset();
+        POD.set_asleep(false);
+        publish(&sampler);
     }
+}
+
+/// The sampler's counters for the status line, and the pipeline task woken.
+fn publish(sampler: &ImuSampler<Bus, SpinDelay>) {
+    let c = sampler.counters();
+    COUNTERS.lock(|cell| cell.set(c));
+    QUEUED.signal(());
 }
 
 /// The pipeline and the logs; every stride to the foot pod.
@@ -419,17 +437,14 @@ async fn main(spawner: Spawner) {
     let imu = Mpu6050::new(bus, Address::Ad0Low);
     let mode = ReadMode::Fifo { batch: FIFO_BATCH };
     let sampler = live_app::start_sensor(imu, delay, SENSOR, mode, &mut serial);
-    let int = InputChannel::new(
-        p.GPIOTE_CH0,
-        p.P0_03,
-        Pull::None,
-        InputChannelPolarity::LoToHi,
-    );
     let (producer, consumer) = QUEUE.take().split();
 
     interrupt::EGU1_SWI1.set_priority(Priority::P3);
     let high = SAMPLER_EXECUTOR.start(interrupt::EGU1_SWI1);
-    high.spawn(sampler_task(sampler, producer, int).unwrap_or_else(|e| defmt::panic!("{}", e)));
+    high.spawn(
+        sampler_task(sampler, producer, p.GPIOTE_CH0, p.P0_03)
+            .unwrap_or_else(|e| defmt::panic!("{}", e)),
+    );
 
     let adc = saadc::Saadc::new(
         p.SAADC,
