@@ -204,3 +204,127 @@ fn the_wake_rule_catches_real_walks_and_keeps_still_through_real_stands() {
         assert!(share(r.slept_through) <= 0.01, "{r:?}");
     }
 }
+
+/// A mocked bus that cannot be recovered (the sampler's trait for boards).
+struct MockBus(embedded_hal_mock::eh1::i2c::Mock);
+
+impl embedded_hal::i2c::ErrorType for MockBus {
+    type Error = embedded_hal::i2c::ErrorKind;
+}
+
+impl embedded_hal::i2c::I2c for MockBus {
+    fn transaction(
+        &mut self,
+        address: u8,
+        operations: &mut [embedded_hal::i2c::Operation<'_>],
+    ) -> Result<(), Self::Error> {
+        self.0.transaction(address, operations)
+    }
+    // The mock expects the plain calls the driver makes, not their transaction form.
+    fn write(&mut self, address: u8, bytes: &[u8]) -> Result<(), Self::Error> {
+        self.0.write(address, bytes)
+    }
+    fn write_read(&mut self, address: u8, w: &[u8], r: &mut [u8]) -> Result<(), Self::Error> {
+        self.0.write_read(address, w, r)
+    }
+}
+
+impl gaitclip_board::imu_sampler::BusRecovery for MockBus {
+    fn recover_bus(&mut self) -> bool {
+        false
+    }
+}
+
+/// The sampler's way into the cycle mode and back, in the live boards' FIFO mode, every bus
+/// transaction spelt out (registers from the register map, not the driver): after the
+/// sample the sleep was asked for, the driver's motion wait; on motion, 6-axis sampling, the
+/// FIFO and the data-ready pulse again; the settling sample read and dropped.
+#[test]
+fn sleep_and_wake_on_the_bus_transaction_by_transaction() {
+    use embedded_hal_mock::eh1::i2c::{Mock, Transaction as T};
+    const A: u8 = 0x68;
+    let sample = |k: u8| vec![0, k, 0, 2, 0, 3, 0, 4, 0, 5, 0, 6, 0, 7];
+    let mut expected = vec![
+        // start: probe, reset, PLL, divider 4 (200 Hz), DLPF 2, ±2000 °/s, ±16 g
+        T::write_read(A, vec![0x75], vec![0x68]),
+        T::write(A, vec![0x6B, 0x80]),
+        T::write(A, vec![0x6B, 0x01]),
+        T::write(A, vec![0x19, 4]),
+        T::write(A, vec![0x1A, 2]),
+        T::write(A, vec![0x1B, 3 << 3]),
+        T::write(A, vec![0x1C, 3 << 3]),
+        // FIFO reset and on (accel, temp, gyro), INT pulsing on data ready
+        T::write(A, vec![0x6A, 0x04]),
+        T::write(A, vec![0x23, 0xF8]),
+        T::write(A, vec![0x6A, 0x40]),
+        T::write(A, vec![0x37, 0x00]),
+        T::write(A, vec![0x38, 0x01]),
+        // one burst of one sample
+        T::write_read(A, vec![0x3A], vec![0x01]),
+        T::write_read(A, vec![0x72], vec![0, 14]),
+        T::write_read(A, vec![0x74], sample(1)),
+    ];
+    // the motion wait: interrupts, FIFO off; ±16 g with the 5 Hz high-pass; MOT_THR 3
+    // (96 mg of 32 mg) read back; MOT_DUR 1 ms; INT latched; MOT_EN; LP_WAKE_CTRL 1 (5 Hz)
+    // and the gyro in standby; CYCLE | TEMP_DIS.
+    expected.extend([
+        T::write(A, vec![0x38, 0x00]),
+        T::write(A, vec![0x6A, 0x00]),
+        T::write(A, vec![0x23, 0x00]),
+        T::write(A, vec![0x1C, 0x18 | 0x01]),
+        T::write(A, vec![0x1F, 3]),
+        T::write_read(A, vec![0x1F], vec![3]),
+        T::write(A, vec![0x20, 1]),
+        T::write(A, vec![0x37, 0x30]),
+        T::write(A, vec![0x38, 0x40]),
+        T::write(A, vec![0x6C, 0x40 | 0x07]),
+        T::write(A, vec![0x6B, 0x20 | 0x08]),
+    ]);
+    // motion: PLL clock, no standby, filter off, MOT off and its latch read; FIFO and the
+    // data-ready pulse as at start; then a burst of two, the first dropped (settling).
+    expected.extend([
+        T::write(A, vec![0x6B, 0x01]),
+        T::write(A, vec![0x6C, 0x00]),
+        T::write(A, vec![0x1C, 0x18]),
+        T::write(A, vec![0x38, 0x00]),
+        T::write_read(A, vec![0x3A], vec![0x40]),
+        T::write(A, vec![0x6A, 0x04]),
+        T::write(A, vec![0x23, 0xF8]),
+        T::write(A, vec![0x6A, 0x40]),
+        T::write(A, vec![0x37, 0x00]),
+        T::write(A, vec![0x38, 0x01]),
+        T::write_read(A, vec![0x3A], vec![0x01]),
+        T::write_read(A, vec![0x72], vec![0, 28]),
+        T::write_read(A, vec![0x74], sample(2)),
+        T::write_read(A, vec![0x74], sample(3)),
+    ]);
+    let mock = Mock::new(&expected);
+    let config = Config::new(OutputRate::from_hz(200).unwrap());
+    let Ok(mut s) = ImuSampler::start(
+        Mpu6050::new(MockBus(mock.clone()), Address::Ad0Low),
+        NoopDelay,
+        config,
+        ReadMode::Fifo { batch: 1 },
+    ) else {
+        panic!("the sensor starts");
+    };
+    let mut items = Vec::new();
+    s.request_sleep(1, SLEEP.wake);
+    s.on_data_ready(&mut push_into(&mut items));
+    assert!(s.asleep());
+    // INT while asleep is motion: the board calls on_motion (a data-ready call is ignored).
+    s.on_data_ready(&mut push_into(&mut items));
+    s.on_motion(40, 1, &mut push_into(&mut items));
+    s.on_data_ready(&mut push_into(&mut items));
+    let accel_x = |i: &Item| match i {
+        Item::Sample(s) => Some(s.accel[0]),
+        _ => None,
+    };
+    assert_eq!(items.len(), 4, "{items:?}");
+    assert_eq!(accel_x(&items[0]), Some(1));
+    assert_eq!(items[1], Item::Asleep);
+    assert_eq!(items[2], Item::Woke(41));
+    assert_eq!(accel_x(&items[3]), Some(3));
+    assert_eq!(s.counters().bus_errors, 0);
+    s.bus_mut().0.done();
+}
