@@ -328,3 +328,24 @@ fn sleep_and_wake_on_the_bus_transaction_by_transaction() {
     assert_eq!(s.counters().bus_errors, 0);
     s.bus_mut().0.done();
 }
+
+/// The policy's rules for each queue item: samples count towards the still period (a due
+/// sleep comes back as the count past the queue), going to sleep, holes and wake-ups reset.
+#[test]
+fn the_policy_after_each_item() {
+    let rate = SampleRate::from_hz(RATE).unwrap();
+    let mut p = SleepPolicy::new(rate, &SLEEP);
+    let s = Item::Sample(RawSample::default());
+    let due: Vec<u32> = (1..=2000u32)
+        .filter_map(|n| p.after_item(&s, true, false, n, 32))
+        .collect();
+    assert_eq!(due, [2033]);
+    for reset in [Item::Asleep, Item::Gap(3), Item::Woke(600)] {
+        for n in 0..10 {
+            assert_eq!(p.after_item(&s, true, false, n, 32), None);
+        }
+        assert!(p.still_samples() > 0);
+        assert_eq!(p.after_item(&reset, true, false, 0, 32), None);
+        assert_eq!(p.still_samples(), 0, "{reset:?}");
+    }
+}

@@ -114,7 +114,7 @@ where
     pub fn on_data_ready(&self) {
         self.pulses
             .store(self.pulses().wrapping_add(1), Ordering::Relaxed);
-        self.with(|s, mut push| s.on_data_ready(&mut push));
+        self.with_sampler(|s, mut push| s.on_data_ready(&mut push));
     }
 
     /// The body of the INT pin's interrupt on a board that sleeps: data ready while the
@@ -144,7 +144,7 @@ where
     /// elapse per tick.
     pub fn on_watchdog_tick(&self, watchdog: &mut Watchdog, periods_per_tick: u32) {
         if let Some(lost) = watchdog.tick(self.pulses(), periods_per_tick) {
-            self.with(|s, mut push| s.on_silence(lost, &mut push));
+            self.with_sampler(|s, mut push| s.on_silence(lost, &mut push));
         }
     }
 
@@ -182,10 +182,6 @@ where
             // spans this point.
             unsafe { irq::enable() };
         }
-    }
-
-    fn with(&self, f: impl FnOnce(&mut ImuSampler<I, D>, &mut dyn FnMut(Item) -> bool)) {
-        self.with_sampler(f);
     }
 
     /// Runs `f` on the sampler and a push into the queue, in a critical section; `None`
@@ -239,8 +235,6 @@ pub struct Drain {
     queue_len: usize,
     /// A sleep the policy asked for, for the board to hand to the sampler.
     sleep_request: Option<u32>,
-    /// The sensor is in its wait for motion (between [`Item::Asleep`] and [`Item::Woke`]).
-    asleep: bool,
 }
 
 impl Drain {
@@ -256,7 +250,6 @@ impl Drain {
             policy: SleepPolicy::new(config.rate, &SLEEP),
             queue_len,
             sleep_request: None,
-            asleep: false,
         }
     }
 
@@ -264,12 +257,6 @@ impl Drain {
     /// [`SampleLink::request_sleep`] (or [`ImuSampler::request_sleep`]).
     pub fn take_sleep_request(&mut self) -> Option<u32> {
         self.sleep_request.take()
-    }
-
-    /// Whether the sensor is in its wait for motion: the board stops its sensor watchdog
-    /// and slows its radio.
-    pub const fn asleep(&self) -> bool {
-        self.asleep
     }
 
     /// Samples processed so far.
@@ -297,25 +284,18 @@ impl Drain {
                     if let Some(e) = self.startup.update(pipeline) {
                         log.startup(e, serial);
                     }
-                    if self
-                        .policy
-                        .after_sample(pipeline.at_rest(), stride.is_some())
-                    {
-                        self.sleep_request =
-                            Some(SleepPolicy::sleep_after(self.samples, self.queue_len));
-                    }
                 }
-                Item::Asleep => {
-                    log.asleep(self.policy.still_samples(), &SLEEP, serial);
-                    self.policy.reset();
-                    self.asleep = true;
-                }
-                Item::Woke(_) => {
-                    self.policy.reset();
-                    self.asleep = false;
-                }
-                Item::Gap(_) => self.policy.reset(),
+                Item::Asleep => log.asleep(self.policy.still_samples(), &SLEEP, serial),
+                Item::Gap(_) | Item::Woke(_) => {}
             }
+            let due = self.policy.after_item(
+                &item,
+                pipeline.at_rest(),
+                stride.is_some(),
+                self.samples,
+                self.queue_len,
+            );
+            self.sleep_request = due.or(self.sleep_request);
             if let Some(stride) = &stride {
                 log.stride(stride, serial);
                 on_stride(stride);

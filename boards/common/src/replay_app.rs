@@ -204,15 +204,13 @@ fn handle<D: StepDetector>(
             if let Some(e) = startup.update(pipeline) {
                 log.startup(e, serial);
             }
-            if policy.after_sample(pipeline.at_rest(), stride.is_some()) {
-                LINK.request_sleep(SleepPolicy::sleep_after(*samples, QUEUE_LEN), SLEEP.wake);
-            }
         }
-        Item::Asleep => {
-            log.asleep(policy.still_samples(), &SLEEP, serial);
-            policy.reset();
-        }
-        Item::Gap(_) | Item::Woke(_) => policy.reset(),
+        Item::Asleep => log.asleep(policy.still_samples(), &SLEEP, serial),
+        Item::Gap(_) | Item::Woke(_) => {}
+    }
+    let at_rest = pipeline.at_rest();
+    if let Some(after) = policy.after_item(&item, at_rest, stride.is_some(), *samples, QUEUE_LEN) {
+        LINK.request_sleep(after, SLEEP.wake);
     }
     // A stride a gap hands back was closed before it: it comes first.
     if let Some(stride) = &stride {

@@ -28,6 +28,8 @@
 use gaitclip::mpu6050::{MotionThreshold, MotionThresholdUnit, MotionWake, WakeRate};
 use gaitclip::rate::SampleRate;
 
+use crate::imu_sampler::Item;
+
 /// When and how the clip sleeps.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct SleepSettings {
@@ -110,6 +112,32 @@ impl SleepPolicy {
     /// After a hole or a wake-up: stillness counts again from nothing.
     pub fn reset(&mut self) {
         self.still = 0;
+    }
+
+    /// The policy's part in the main loop, after `item` went through the pipeline
+    /// (`at_rest` its rest test then, `stride` whether it closed one, `processed` the
+    /// samples processed so far, `queue_len` the queue's capacity): a sample counts towards
+    /// the still period and may make a sleep due, returned as the count for
+    /// [`crate::imu_sampler::ImuSampler::request_sleep`]; going to sleep, a hole or a
+    /// wake-up starts the count again. A caller that logs the sleep reads
+    /// [`SleepPolicy::still_samples`] before handing the [`Item::Asleep`] here.
+    pub fn after_item(
+        &mut self,
+        item: &Item,
+        at_rest: bool,
+        stride: bool,
+        processed: u32,
+        queue_len: usize,
+    ) -> Option<u32> {
+        match item {
+            Item::Sample(_) => self
+                .after_sample(at_rest, stride)
+                .then(|| Self::sleep_after(processed, queue_len)),
+            Item::Asleep | Item::Gap(_) | Item::Woke(_) => {
+                self.reset();
+                None
+            }
+        }
     }
 
     /// The sample count, as the sampler counts what it read
