@@ -54,7 +54,7 @@ use crate::phase_stats::{StrideStats, CHANNELS};
 use crate::phases::{self, PhaseMethod};
 use crate::pipeline::Config;
 use crate::rate::SampleRate;
-use crate::sample::RawSample;
+use crate::sample::{Rails, RawSample};
 use crate::stride::{magnitude_minus_g, Origin, Stride, StrideFlags, MAX_STANCE_IN_STRIDE_MS};
 use crate::units::{AccelScale, FootAccel, GyroScale};
 use crate::zupt::{RollingContact, ZuptIntegrator};
@@ -115,6 +115,8 @@ pub struct CycleConfig {
     pub spacing: u32,
     /// See [`MAX_STANCE_IN_STRIDE_MS`].
     pub max_stance: u32,
+    /// Samples of [`crate::stride::MAX_MOVEMENT_MS`].
+    pub max_movement: u32,
     /// Gyro counts² → Q40 of (rad/s)²/σω².
     k_w: u64,
     /// Accelerometer counts² → Q40 of (m/s²)²/σa².
@@ -125,15 +127,21 @@ pub struct CycleConfig {
     pub phases: PhaseMethod,
     merge: u32,
     integrator: ZuptIntegrator,
+    /// Where each axis clips.
+    pub rails: Rails,
+    /// Whether the accelerometer's loss at its rails is put back ([`Config::restore_accel`]).
+    pub restore_accel: bool,
 }
 
 impl CycleConfig {
-    /// The constants for `rate`, the ranges, Huang's splitter `phases` and a sensor
-    /// `sensor_height_um` above the foot's rolling contact ([`SENSOR_HEIGHT_UM`]).
+    /// The constants for `rate`, the ranges and their `rails`, Huang's splitter `phases`
+    /// and a sensor `sensor_height_um` above the foot's rolling contact
+    /// ([`SENSOR_HEIGHT_UM`]).
     pub const fn new(
         rate: SampleRate,
         accel: AccelScale,
         gyro: GyroScale,
+        rails: Rails,
         phases: PhaseMethod,
         sensor_height_um: u32,
     ) -> Self {
@@ -162,12 +170,15 @@ impl CycleConfig {
             confirm: rate.samples_in_ms(CONFIRM_MS),
             spacing: rate.samples_in_ms(MIN_SPACING_MS),
             max_stance: rate.samples_in_ms(MAX_STANCE_IN_STRIDE_MS),
+            max_movement: rate.samples_in_ms(crate::stride::MAX_MOVEMENT_MS),
             k_w: k_w as u64,
             k_a: k_a as u64,
             rolling: RollingContact::new(sensor_height_um, rate, gyro),
             phases,
             merge: rate.samples_in_ms(phases::MERGE_MS),
             integrator: ZuptIntegrator::new(rate, gyro),
+            rails,
+            restore_accel: true,
         }
     }
 
@@ -301,6 +312,9 @@ pub struct CycleDetector<const M: usize> {
     /// (`movement[0]` is sample `mv_origin`), less the samples of a slow swing's dip that
     /// were taken for a stance (`mv_gap`: buffer position and samples skipped there).
     movement: Vec<[i16; CHANNELS], M>,
+    /// Samples of a movement kept ([`crate::stride::MAX_MOVEMENT_MS`] at the rate, at most
+    /// `M`).
+    max_movement: usize,
     mv_origin: u32,
     mv_gap: Option<(usize, u32)>,
     /// The stance before the candidate was long (a rest).
@@ -323,13 +337,16 @@ const fn per_window(q16: u64, w: u32) -> u64 {
 impl<const M: usize> CycleDetector<M> {
     /// The detector for data described by `config`.
     pub const fn new(config: &Config) -> Self {
-        Self::with_config(CycleConfig::new(
+        let mut cfg = CycleConfig::new(
             config.rate,
             config.accel,
             config.gyro,
+            config.rails,
             config.phases,
             config.sensor_height_um,
-        ))
+        );
+        cfg.restore_accel = config.restore_accel;
+        Self::with_config(cfg)
     }
 
     /// A detector with no history.
@@ -349,6 +366,11 @@ impl<const M: usize> CycleDetector<M> {
             low_start: 0,
             in_low: false,
             movement: Vec::new(),
+            max_movement: if (cfg.max_movement as usize) < M {
+                cfg.max_movement as usize
+            } else {
+                M
+            },
             mv_origin: 0,
             mv_gap: None,
             from_rest: false,
@@ -482,11 +504,17 @@ impl<const M: usize> CycleDetector<M> {
         let in_low = self.in_low;
         if let Some(c) = self.cur.as_mut() {
             if i != c.start {
-                c.integrator.process(s);
+                c.integrator.process(s, &self.cfg.rails);
             }
             // After a candidate the samples are the next stride's (below).
             if self.cand.is_none() {
-                mark(&mut c.flags, s, origin, c.heel_off.is_some() && !in_low);
+                mark(
+                    &mut c.flags,
+                    s,
+                    &self.cfg.rails,
+                    origin,
+                    c.heel_off.is_some() && !in_low,
+                );
             }
             // Heel-off: the energy first above the instant's (or the rest's) by the edge
             // ratio.
@@ -503,10 +531,11 @@ impl<const M: usize> CycleDetector<M> {
         }
         if let Some(c) = self.cand.as_mut() {
             if i != c.index {
-                self.next.process(s);
+                self.next.process(s, &self.cfg.rails);
                 mark(
                     &mut c.next_flags,
                     s,
+                    &self.cfg.rails,
                     origin,
                     c.next_heel_off.is_some() && !in_low,
                 );
@@ -519,7 +548,7 @@ impl<const M: usize> CycleDetector<M> {
             }
         }
         let moving = self.cur.as_ref().is_some_and(|c| c.heel_off.is_some());
-        if moving {
+        if moving && self.movement.len() < self.max_movement {
             // Full: what is lost is counted when the stride closes (too long).
             let _ = self
                 .movement
@@ -650,7 +679,7 @@ impl<const M: usize> CycleDetector<M> {
                 if self.mv_gap.is_none() && skipped < u32::MAX / 2 {
                     self.mv_gap = Some((tail_pos, skipped));
                 }
-                let len = tail_pos + ff.wrapping_sub(nh).min(M as u32) as usize;
+                let len = tail_pos + ff.wrapping_sub(nh).min(self.max_movement as u32) as usize;
                 (len.min(self.movement.len()), ff.wrapping_sub(h))
             }
             (Some(h), _) => {
@@ -808,6 +837,7 @@ impl<const M: usize> CycleDetector<M> {
             cur,
             cand,
             movement,
+            max_movement,
             mv_origin,
             mv_gap,
             next_index,
@@ -826,7 +856,7 @@ impl<const M: usize> CycleDetector<M> {
         if cur.broken.is_some() {
             flags |= StrideFlags::GAP;
         }
-        if c.movement_needed as usize > M {
+        if c.movement_needed as usize > *max_movement {
             flags |= StrideFlags::TOO_LONG;
         }
         let len = c.movement_len.min(movement.len());
@@ -854,7 +884,9 @@ impl<const M: usize> CycleDetector<M> {
         let v_end = cfg
             .rolling
             .velocity_q8(c.snap.attitude(), c.omega, c.snap.gravity_q8());
-        let d = c.snap.displacement_restoring_tilt(v_end, c.gravity);
+        let d = c
+            .snap
+            .displacement_restoring(v_end, c.gravity, &cfg.rails, cfg.restore_accel);
         let (toe_off, heel_strike) = match (cur.heel_off, cur.broken) {
             // Events found after the hole are set to it: the buffer does not count the
             // samples lost in it, and the restart did not see them.
@@ -912,13 +944,14 @@ fn sample_of(origin: u32, gap: Option<(usize, u32)>, p: u32) -> u32 {
     }
 }
 
-/// What a sample sets in its stride's flags: a rail of either sensor, and an interpolated
-/// sample (in the movement a filled one makes it a gap stride, anything else bridged).
-fn mark(flags: &mut u16, s: &RawSample, origin: Origin, moving: bool) {
-    if s.accel_saturated() {
-        *flags |= StrideFlags::SATURATED;
+/// What a sample sets in its stride's flags: a rail of either sensor (restored at the
+/// stride's close), and an interpolated sample (in the movement a filled one makes it a gap
+/// stride, anything else bridged).
+fn mark(flags: &mut u16, s: &RawSample, rails: &Rails, origin: Origin, moving: bool) {
+    if rails.accel_clipped(s) {
+        *flags |= StrideFlags::ACCEL_CLIPPED;
     }
-    if s.gyro_saturated() {
+    if rails.gyro_clipped(s) {
         *flags |= StrideFlags::GYRO_CLIPPED;
     }
     match (origin, moving) {

@@ -161,12 +161,13 @@ impl QuatQ30 {
     };
 
     /// Advances the attitude by body rates given as half-angle increments
-    /// `h = ω·dt/2` (Q30 radians per axis, |h| ≤ 0.2): `q ← q + q ⊗ (0, h')`, then one Newton
+    /// `h = ω·dt/2` (Q30 radians per axis, |h| ≤ 0.35: the ±2000 °/s rail at 50 Hz):
+    /// `q ← q + q ⊗ (0, h')`, then one Newton
     /// step of normalisation. The normalised first-order step turns by `2·atan|h'|`, not
     /// `2·|h|`; pre-scaling `h' = h·(1 + |h|²/3)` cancels that to O(|h|⁵), so a step of
     /// θ = 2|h| rad errs by about θ⁵/120 (8e−11 rad at θ = 0.025, 5 rad/s at 200 Hz;
-    /// 4.3e−5 rad at θ = 0.35, the ±2000 °/s rail at 100 Hz). Up to three Newton steps keep
-    /// the norm within 2⁻²⁶ (1.5e−8) of one.
+    /// 4.3e−5 rad at θ = 0.35, the ±2000 °/s rail at 100 Hz; 1.4e−3 rad at θ = 0.7, the
+    /// rail at 50 Hz). Up to three Newton steps keep the norm within 2⁻²⁶ (1.5e−8) of one.
     pub const fn integrate_half_angle(self, h: [i32; 3]) -> QuatQ30 {
         let (w, x, y, z) = (self.w as i64, self.x as i64, self.y as i64, self.z as i64);
         let h2 =

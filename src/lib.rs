@@ -80,8 +80,10 @@
 #![deny(missing_docs)]
 
 pub mod bridge;
+pub mod clipping;
 pub mod cycle;
 pub mod detector;
+pub mod estimate;
 pub mod features;
 pub mod fixed;
 pub mod foot_frame;

@@ -30,6 +30,7 @@ use crate::bridge;
 use crate::cycle::Calibration;
 pub use crate::detector::Detector;
 use crate::detector::{AnyDetector, DelayLines, Drain, Input, StepDetector};
+use crate::estimate::LengthEstimator;
 use crate::foot_frame::FootFrameEstimator;
 use crate::gait::GaitTimer;
 use crate::mean_filter::MeanFilter;
@@ -38,7 +39,7 @@ use crate::phase_stats::StrideStats;
 use crate::phases::PhaseMethod;
 use crate::rate::SampleRate;
 use crate::rest::{RestDetector, RestThresholds};
-use crate::sample::RawSample;
+use crate::sample::{Rails, RawSample};
 use crate::stance::StanceLimits;
 use crate::stride::{Origin, Stride, MAX_MOVEMENT_SAMPLES, MIN_MOVEMENT_MS};
 use crate::units::{AccelScale, GyroScale};
@@ -82,6 +83,13 @@ pub struct Config {
     pub accel: AccelScale,
     /// Gyroscope scale of the counts (counts per °/s; [`crate::sample::GyroRange::scale`]).
     pub gyro: GyroScale,
+    /// Where each axis clips, counts ([`Rails::FULL_SCALE`] for the MPU6050; a replayed
+    /// recording's are learnt from its data or given).
+    pub rails: Rails,
+    /// Whether the cycle detector puts back what a clipped accelerometer lost
+    /// ([`crate::clipping`]; true). A setting so that the clipping sweep can measure what
+    /// the restoration does.
+    pub restore_accel: bool,
     /// Step detector.
     pub detector: Detector,
     /// Phase splitter version.
@@ -112,6 +120,8 @@ impl Config {
             rate,
             accel,
             gyro,
+            rails: Rails::FULL_SCALE,
+            restore_accel: true,
             detector: Detector::Cycle,
             phases: PhaseMethod::Augmented,
             model: DEFAULT_MODEL,
@@ -205,6 +215,8 @@ pub struct Pipeline<D = AnyDetector<MAX_MOVEMENT_SAMPLES>> {
     detector: D,
     lines: DelayLines,
     chain: LengthChain,
+    /// A length for the strides that could not be measured, from those that were.
+    estimate: LengthEstimator,
     /// The last stage: gait parameters from the events and the length.
     gait: GaitTimer,
     /// Accelerometer counts per g.
@@ -225,6 +237,10 @@ pub struct Pipeline<D = AnyDetector<MAX_MOVEMENT_SAMPLES>> {
     finishing: bool,
     /// The rest test's latest decision (false until its window has filled).
     at_rest: bool,
+    /// Where each axis clips, and the measured samples at a rail per axis (accelerometer x,
+    /// y, z, gyroscope x, y, z).
+    rails: Rails,
+    clipped: [u32; 6],
 }
 
 impl Pipeline {
@@ -260,6 +276,7 @@ impl<D: StepDetector> Pipeline<D> {
             detector,
             lines: DelayLines::new(),
             gait: GaitTimer::new(config.rate),
+            estimate: LengthEstimator::new(),
             chain: LengthChain {
                 model: config.model,
                 settings: config.settings,
@@ -293,7 +310,15 @@ impl<D: StepDetector> Pipeline<D> {
             since_reset: 0,
             finishing: false,
             at_rest: false,
+            rails: config.rails,
+            clipped: [0; 6],
         }
+    }
+
+    /// Samples read at a rail so far, per axis: accelerometer x, y, z, gyroscope x, y, z
+    /// (interpolated samples are not counted). What a board's summary reports.
+    pub const fn clipped_samples(&self) -> [u32; 6] {
+        self.clipped
     }
 
     /// Latency of the detector's decision in samples: the decision about a sample is made
@@ -442,6 +467,12 @@ impl<D: StepDetector> Pipeline<D> {
         self.next = self.next.wrapping_add(1);
         self.lines.push(index, s, origin);
         self.since_reset = self.since_reset.saturating_add(1);
+        if origin == Origin::Measured {
+            let bits = self.rails.clipped_axes(s);
+            if bits != 0 {
+                self.count_clipped(bits);
+            }
+        }
         let filtered = self.filter.process(s.accel);
         if let Some(rest) = self.rest.process(filtered, s.gyro) {
             self.at_rest = rest;
@@ -522,6 +553,16 @@ impl<D: StepDetector> Pipeline<D> {
         self.holes.restarted = self.holes.restarted.saturating_add(1);
         self.holes.restarted_samples = self.holes.restarted_samples.saturating_add(total);
         self.restart_after(total)
+    }
+
+    /// Counts the axes of `bits` ([`Rails::clipped_axes`]). Off the sample path's frame.
+    #[inline(never)]
+    fn count_clipped(&mut self, bits: u8) {
+        for (k, c) in self.clipped.iter_mut().enumerate() {
+            if bits & (1 << k) != 0 {
+                *c = c.saturating_add(1);
+            }
+        }
     }
 
     /// What a hole of `missing` samples, on its own, becomes.
@@ -622,9 +663,11 @@ impl<D: StepDetector> Pipeline<D> {
         s
     }
 
-    /// The stages after the detector: the length, then the gait parameters that need it.
+    /// The stages after the detector: the length (measured, or estimated where it could
+    /// not be), then the gait parameters that need it.
     fn complete(&mut self, s: &mut Stride) {
         self.detector.measure(s, &self.chain);
+        self.estimate.process(s);
         self.gait.process(s);
     }
 }

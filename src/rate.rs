@@ -1,6 +1,6 @@
 //! The sample rate, a parameter of every stage.
 
-/// Sample rate in millihertz, 100–1000 Hz (204.8 Hz is `SampleRate::from_millihertz(204_800)`).
+/// Sample rate in millihertz, 50–1000 Hz (204.8 Hz is `SampleRate::from_millihertz(204_800)`).
 ///
 /// Kept in millihertz so that rates such as 204.8 Hz are exact: integration scales with
 /// 1/rate², where rounding to whole hertz would cost 0.2 % of every length.
@@ -8,12 +8,13 @@
 pub struct SampleRate(u32);
 
 impl SampleRate {
-    /// Slowest supported rate, 100 Hz.
-    pub const MIN_MILLIHERTZ: u32 = 100_000;
+    /// Slowest supported rate, 50 Hz. Below 100 Hz gait events are coarse (10–20 ms a
+    /// sample) and no dataset checks the lengths: the host warns.
+    pub const MIN_MILLIHERTZ: u32 = 50_000;
     /// Fastest supported rate, 1 kHz (the MPU6050's DLPF-on limit).
     pub const MAX_MILLIHERTZ: u32 = 1_000_000;
 
-    /// `None` outside 100–1000 Hz.
+    /// `None` outside 50–1000 Hz.
     pub const fn from_millihertz(mhz: u32) -> Option<Self> {
         if mhz < Self::MIN_MILLIHERTZ || mhz > Self::MAX_MILLIHERTZ {
             None
@@ -22,7 +23,7 @@ impl SampleRate {
         }
     }
 
-    /// `None` outside 100–1000 Hz.
+    /// `None` outside 50–1000 Hz.
     pub const fn from_hz(hz: u32) -> Option<Self> {
         if hz > Self::MAX_MILLIHERTZ / 1000 {
             return None;

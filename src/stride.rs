@@ -32,9 +32,10 @@
 //! followed the gap. A gap inside a stance that goes on after it costs nothing.
 //!
 //! Streaming and bounded: the only per-stride memory is the movement's foot-frame
-//! acceleration, a buffer of `M` samples ([`MAX_MOVEMENT_SAMPLES`] unless a board with
-//! little RAM picks fewer); a longer movement is still closed at the next stance but flagged
-//! [`StrideFlags::TOO_LONG`] and split on what was kept.
+//! acceleration, a buffer of `M` samples of which at most [`MAX_MOVEMENT_MS`] are used
+//! ([`movement_samples`] holds that at a rate; a board with little RAM picks fewer); a longer
+//! movement is still closed at the next stance but flagged [`StrideFlags::TOO_LONG`] and split
+//! on what was kept.
 
 use heapless::Vec;
 
@@ -47,14 +48,28 @@ use crate::phases::{self, PhaseMethod};
 use crate::pipeline::Config;
 use crate::rate::SampleRate;
 use crate::rest::RestSums;
-use crate::sample::RawSample;
+use crate::sample::{Rails, RawSample};
 use crate::stance::{StanceDetector, StanceThresholds};
 use crate::units::{FootAccel, GyroScale};
 use crate::zupt::{Displacement, ZuptIntegrator};
 
-/// Default capacity of the movement buffer: 1.024 s at 1 kHz, 5 s at 204.8 Hz, 10 s at
-/// 100 Hz (a walking movement, heel-off to foot-flat, lasts 0.5–1 s). 6 KiB of state.
-pub const MAX_MOVEMENT_SAMPLES: usize = 1024;
+/// The longest movement (heel-off to foot-flat) kept for the phases, ms, at any rate: a
+/// walking movement lasts 0.5–1 s, a slow backward one 2 s. A longer one is closed at the next
+/// stance but flagged [`StrideFlags::TOO_LONG`]; its ZUPT length, integrated sample by sample,
+/// does not depend on the buffer.
+pub const MAX_MOVEMENT_MS: u32 = 5120;
+
+/// Movement buffer capacity that holds [`MAX_MOVEMENT_MS`] at `rate_hz`: 1 024 samples
+/// (6 KiB) at the boards' 200 Hz, 5 120 at 1 kHz. A board short of RAM picks fewer and
+/// flags longer movements sooner.
+pub const fn movement_samples(rate_hz: u32) -> usize {
+    (rate_hz as usize * MAX_MOVEMENT_MS as usize).div_ceil(1000)
+}
+
+/// Default capacity of the movement buffer: [`MAX_MOVEMENT_MS`] at the fastest supported
+/// rate (1 kHz), so that a pipeline made without naming one (the host's) sizes the buffer by
+/// time at any rate.
+pub const MAX_MOVEMENT_SAMPLES: usize = movement_samples(1000);
 /// A movement shorter than this is a wobble of a foot still on the ground, not a step.
 pub const MIN_MOVEMENT_MS: u32 = 150;
 /// At most this much of a stance counts toward the stride that leaves it: a user who stood
@@ -71,12 +86,14 @@ pub const MAX_STRIDE_MM: u32 = 6000;
 pub struct StrideFlags(pub u16);
 
 impl StrideFlags {
-    /// A sample of the movement sat at a rail of its range and the length could not be
-    /// restored: uncertain. The cycle detector ([`crate::cycle`]) sets it for the
-    /// accelerometer's rails (a gyro at a rail is [`StrideFlags::GYRO_CLIPPED`] there), the
-    /// stance detector for any rail.
+    /// A sample of the movement sat at a rail and nothing put back what it lost: the length
+    /// is not measured (it is estimated, [`StrideFlags::ESTIMATED`]). Set by the stance
+    /// detector (Huang's method, which restores nothing) for any rail; the cycle detector
+    /// restores both sensors instead ([`StrideFlags::ACCEL_CLIPPED`],
+    /// [`StrideFlags::GYRO_CLIPPED`]).
     pub const SATURATED: u16 = 1 << 0;
-    /// The movement overflowed the movement buffer: not a walking stride.
+    /// The movement lasted longer than the movement buffer holds ([`MAX_MOVEMENT_MS`], or
+    /// fewer samples on a board that picks a smaller buffer): not a walking stride.
     pub const TOO_LONG: u16 = 1 << 1;
     /// The stride starts from a stance longer than [`MAX_STANCE_IN_STRIDE_MS`]: the first
     /// step after standing (informational).
@@ -105,7 +122,15 @@ impl StrideFlags {
     /// ([`crate::zupt::ZuptIntegrator::displacement_restoring_tilt`]): the length stays
     /// valid (informational).
     pub const GYRO_CLIPPED: u16 = 1 << 9;
-    /// Flags that make a length untrustworthy.
+    /// The accelerometer sat at a rail in the movement; what it lost was put back where it
+    /// was lost ([`crate::clipping`]): the length stays valid (informational).
+    pub const ACCEL_CLIPPED: u16 = 1 << 10;
+    /// The length was not measured (a flag in [`StrideFlags::INVALID`] says why) and is the
+    /// estimate from the strides before it at the same cadence ([`crate::estimate`]): it
+    /// counts in the distance.
+    pub const ESTIMATED: u16 = 1 << 11;
+    /// Flags that make a measured length untrustworthy: such a stride's length is estimated
+    /// instead ([`StrideFlags::ESTIMATED`]).
     pub const INVALID: u16 = Self::SATURATED | Self::TOO_LONG | Self::GAP | Self::IMPLAUSIBLE;
 
     /// True when no flag in [`StrideFlags::INVALID`] is set.
@@ -116,6 +141,12 @@ impl StrideFlags {
     /// True when `flag` is set.
     pub const fn has(self, flag: u16) -> bool {
         self.0 & flag != 0
+    }
+
+    /// True when the stride's length counts in the distance: measured and valid, or
+    /// estimated.
+    pub const fn counts_distance(self) -> bool {
+        self.valid() || self.has(Self::ESTIMATED)
     }
 }
 
@@ -220,6 +251,8 @@ pub struct StrideTracker<const M: usize = MAX_MOVEMENT_SAMPLES> {
     heel_off: u32,
     stance_sums: RestSums,
     movement: Vec<[i16; CHANNELS], M>,
+    /// Samples of a movement kept: [`MAX_MOVEMENT_MS`] at the rate, at most `M`.
+    max_movement: usize,
     flags: u16,
     /// First and last [`Origin::Filled`] sample of the movement, if any.
     filled: Option<(u32, u32)>,
@@ -243,6 +276,8 @@ pub struct StrideTracker<const M: usize = MAX_MOVEMENT_SAMPLES> {
     /// The phase statistics of the last two strides closed, by stride index parity, with
     /// the index they belong to: a stride's stay until the one after the next is closed.
     stats: [(u32, StrideStats); 2],
+    /// Where each axis clips.
+    rails: Rails,
 }
 
 impl StrideTracker {
@@ -265,6 +300,7 @@ impl<const M: usize> StrideTracker<M> {
             heel_off: 0,
             stance_sums: RestSums::new(),
             movement: Vec::new(),
+            max_movement: max_movement(rate, M),
             flags: 0,
             filled: None,
             stance_bridged_at: None,
@@ -281,7 +317,14 @@ impl<const M: usize> StrideTracker<M> {
                 (u32::MAX, StrideStats::EMPTY),
                 (u32::MAX, StrideStats::EMPTY),
             ],
+            rails: Rails::FULL_SCALE,
         }
+    }
+
+    /// The tracker with each axis clipping at `rails` (by default the counts' extremes).
+    pub const fn with_rails(mut self, rails: Rails) -> Self {
+        self.rails = rails;
+        self
     }
 
     /// Samples were lost after the last one fed (the samples the tracker has not seen count
@@ -559,15 +602,16 @@ impl<const M: usize> StrideTracker<M> {
     }
 
     fn accumulate_movement(&mut self, s: &RawSample, foot: FootAccel) {
-        self.zupt.process(s);
-        if self
-            .movement
-            .push([foot.up(), foot.forward(), magnitude_minus_g(foot)])
-            .is_err()
+        self.zupt.process(s, &self.rails);
+        if self.movement.len() >= self.max_movement
+            || self
+                .movement
+                .push([foot.up(), foot.forward(), magnitude_minus_g(foot)])
+                .is_err()
         {
             self.flags |= StrideFlags::TOO_LONG;
         }
-        if s.is_saturated() {
+        if self.rails.accel_clipped(s) || self.rails.gyro_clipped(s) {
             self.flags |= StrideFlags::SATURATED;
         }
     }
@@ -630,6 +674,17 @@ impl<const M: usize> StrideTracker<M> {
     }
 }
 
+/// Samples of a movement kept at `rate` in a buffer of `capacity`: [`MAX_MOVEMENT_MS`], at
+/// most the capacity.
+pub(crate) const fn max_movement(rate: SampleRate, capacity: usize) -> usize {
+    let n = rate.samples_in_ms(MAX_MOVEMENT_MS) as usize;
+    if n < capacity {
+        n
+    } else {
+        capacity
+    }
+}
+
 /// `|f| − g` of a foot-frame sample `[forward, left, up − g]` (g/2048), in g/2048,
 /// saturated to `i16`: the orientation-free magnitude channel of [`crate::phase_stats`].
 pub(crate) fn magnitude_minus_g(foot: FootAccel) -> i16 {
@@ -666,7 +721,8 @@ impl<const M: usize> StanceStrides<M> {
                 config.gyro,
                 config.stance,
             )),
-            tracker: StrideTracker::sized(config.rate, config.gyro, config.phases),
+            tracker: StrideTracker::sized(config.rate, config.gyro, config.phases)
+                .with_rails(config.rails),
             decided: 0,
             last_decision: false,
             held: None,

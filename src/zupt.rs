@@ -13,10 +13,11 @@
 //! position as `i64` sums. Ranges: movements up to 2³¹ samples do not overflow (velocity
 //! < 2²³·n, doubled position < 2²⁴·n²; `i64` holds n = 2²⁰ with margin).
 
+use crate::clipping::{ClippedAccel, RailRun};
 use crate::fixed::{atan2_cdeg, div_round_i128, isqrt_u64, QuatQ30};
 use crate::rate::SampleRate;
 use crate::rest::RestSums;
-use crate::sample::RawSample;
+use crate::sample::{Rails, RawSample};
 use crate::units::GyroScale;
 
 /// π · 2³².
@@ -118,6 +119,8 @@ pub struct ZuptIntegrator {
     clipped_c2: i64,
     /// Per gyro axis, the rotation lost at its rail.
     rail_runs: [RailRun; 3],
+    /// What the accelerometer lost at its rails ([`crate::clipping`]).
+    accel: ClippedAccel,
     /// The doubled vertical position every `lift_every` samples (sample `(k + 1)·lift_every`
     /// at `lift[k]`), `lift_len` of them; `lift_countdown` samples to the next.
     lift: [i64; LIFT_POINTS],
@@ -146,6 +149,7 @@ impl ZuptIntegrator {
             clipped_c: 0,
             clipped_c2: 0,
             rail_runs: [RailRun::NEW; 3],
+            accel: ClippedAccel::NEW,
             lift: [0; LIFT_POINTS],
             lift_len: 0,
             lift_every: 1,
@@ -202,6 +206,7 @@ impl ZuptIntegrator {
         self.clipped_c = 0;
         self.clipped_c2 = 0;
         self.rail_runs = [RailRun::NEW; 3];
+        self.accel = ClippedAccel::NEW;
         self.lift_len = 0;
         self.lift_every = 1;
         self.lift_countdown = 1;
@@ -211,6 +216,11 @@ impl ZuptIntegrator {
     /// Samples integrated with a gyro axis at a rail.
     pub const fn clipped(&self) -> u32 {
         self.clipped
+    }
+
+    /// Samples integrated with an accelerometer axis at a rail.
+    pub const fn accel_clipped(&self) -> u32 {
+        self.accel.clipped()
     }
 
     /// The attitude now (sensor to level frame).
@@ -245,8 +255,16 @@ impl ZuptIntegrator {
         v
     }
 
-    /// [`ZuptIntegrator::displacement_to`], with the tilt the clipped gyro samples lost put
-    /// back on them. A rate beyond the rail loses rotation while it is clipped, and the lost
+    /// [`ZuptIntegrator::displacement_to`], with what the rails lost put back: the
+    /// accelerometer's lost force as velocity steps where it was lost
+    /// ([`crate::clipping::ClippedAccel`]), then the gyro's lost tilt.
+    ///
+    /// **Accelerometer.** Clipped runs of two samples or more are reconstructed from their
+    /// shape; single clipped samples take their share of the end-velocity residual (against
+    /// `v_end_q8`), projected onto the directions they lost force along and bounded by a
+    /// rail's worth each.
+    ///
+    /// **Gyro.** A rate beyond the rail loses rotation while it is clipped, and the lost
     /// rotation tilts the level frame from then on, which leaks gravity into the horizontal
     /// acceleration. At the end stance the accelerometer's gravity `end_gravity_q8` (sensor
     /// axes, counts·2⁸, a stance mean) seen through the integrated attitude shows the tilt
@@ -255,18 +273,49 @@ impl ZuptIntegrator {
     /// [`RailRun`] reconstructs above the rails, so the tilt that gyro noise and bias leave on
     /// every stride is not blamed on a few clipped samples. After linear dedrift a tilt step
     /// `s` at sample `c` of `N` leaves the doubled position off by `−s·g·(N − c)·c`, which is
-    /// put back in closed form: `+g·h·(N·Σc − Σc²)/K`. Without clipped samples this is
-    /// `displacement_to`. Measured on traces converted to ±500 and ±250 °/s: see the README.
-    pub fn displacement_restoring_tilt(
+    /// put back in closed form: `+g·h·(N·Σc − Σc²)/K`. Measured on traces converted to ±500
+    /// and ±250 °/s: `gaitclip zupt-sweep`.
+    ///
+    /// Without clipped samples this is `displacement_to`. `restore_accel` false leaves the
+    /// accelerometer's loss in (what the clipping sweep compares against).
+    // Not inlined: its temporaries (the restored sums, `i128` arrays) then take stack only
+    // while it runs, not under the phase split of the stride's close (the M0's stack).
+    #[inline(never)]
+    pub fn displacement_restoring(
         &self,
         v_end_q8: [i64; 3],
         end_gravity_q8: [i64; 3],
+        rails: &Rails,
+        restore_accel: bool,
     ) -> Displacement {
-        let drift = self.drift_to(v_end_q8);
-        let mut position = self.position_x2_q8;
-        if self.clipped == 0 {
-            return self.displacement_of(drift, position);
+        let (mut velocity, mut position) = (self.velocity_q8, self.position_x2_q8);
+        if restore_accel && self.accel.clipped() > 0 {
+            (velocity, position) = self.accel.restore(
+                self.velocity_q8,
+                self.position_x2_q8,
+                self.samples,
+                &rails.accel,
+                v_end_q8,
+            );
         }
+        let mut drift = velocity;
+        for (v, e) in drift.iter_mut().zip(v_end_q8) {
+            *v = v.saturating_sub(e);
+        }
+        if self.clipped > 0 {
+            self.restore_tilt(&mut position, end_gravity_q8, &rails.gyro);
+        }
+        self.displacement_of(drift, position)
+    }
+
+    /// The gyro part of [`ZuptIntegrator::displacement_restoring`]: the lost tilt's effect
+    /// on the doubled position.
+    fn restore_tilt(
+        &self,
+        position: &mut [i64; 3],
+        end_gravity_q8: [i64; 3],
+        rails: &[crate::sample::AxisRails; 3],
+    ) {
         let r = self.attitude.matrix();
         let level: [i128; 3] = r.map(|row| {
             row.iter()
@@ -280,13 +329,14 @@ impl ZuptIntegrator {
         let lxy2 = level[0] * level[0] + level[1] * level[1];
         let lxy = isqrt_u64(lxy2.clamp(0, u64::MAX as i128) as u64) as i128;
         if norm == 0 || lxy == 0 {
-            return self.displacement_of(drift, position);
+            return;
         }
         // The rotation lost above the rails, rad Q30: counts·samples × rad per count·sample.
         let lost_area: i128 = self
             .rail_runs
             .iter()
-            .map(|r| r.lost_counts_samples() as i128)
+            .zip(rails.iter())
+            .map(|(r, &rails)| r.lost_counts_samples(rails) as i128)
             .sum();
         let lost_q30 = (lost_area * 2 * self.half_angle_per_count_q46 as i128) >> 16;
         // h per axis, rad Q30: the measured tilt, or the lost rotation along it if smaller.
@@ -307,11 +357,10 @@ impl ZuptIntegrator {
             );
             *p = (*p as i128 + fix).clamp(i64::MIN as i128, i64::MAX as i128) as i64;
         }
-        self.displacement_of(drift, position)
     }
 
-    /// Integrates one sample of the movement.
-    pub fn process(&mut self, s: &RawSample) {
+    /// Integrates one sample of the movement, clipped where `rails` say.
+    pub fn process(&mut self, s: &RawSample, rails: &Rails) {
         let mut h = [0i32; 3];
         for ((h, &g), &b) in h.iter_mut().zip(s.gyro.iter()).zip(self.gyro_bias.iter()) {
             let w = g as i64 - b as i64;
@@ -337,10 +386,16 @@ impl ZuptIntegrator {
         }
         self.samples = self.samples.saturating_add(1);
         self.keep_lift_point();
-        for (run, &g) in self.rail_runs.iter_mut().zip(s.gyro.iter()) {
-            run.process(g);
+        self.accel.process(self.samples, &s.accel, &rails.accel, &r);
+        for ((run, &g), &rails) in self
+            .rail_runs
+            .iter_mut()
+            .zip(s.gyro.iter())
+            .zip(rails.gyro.iter())
+        {
+            run.process(g, rails);
         }
-        if s.gyro_saturated() {
+        if rails.gyro_clipped(s) {
             // Σc < 2³², Σc² < 2⁴⁸ for movements up to 2¹⁶ samples.
             let c = self.samples as i64;
             self.clipped = self.clipped.saturating_add(1);
@@ -440,113 +495,5 @@ impl ZuptIntegrator {
             vertical_um: clamp(um(2)),
             max_lift_um: top_um.clamp(0, u32::MAX as i128) as u32,
         }
-    }
-}
-
-/// The rotation one gyro axis lost at its rail, reconstructed per clipped run: the true rate
-/// is taken to rise over the rail and fall back as a parabola. A parabola that stays above
-/// the rail for `T` samples and crosses it with slope `s` holds `s·T²/6` counts·samples
-/// above it. `T` is taken as the run's clipped samples `L`; the slope at the crossing from
-/// the secant of the two unclipped samples next to the run, which on a parabola lies about
-/// one sample further out and is steeper by the factor `(L + 2)/L`; the two sides averaged:
-/// `(s_in + s_out)·L³ / (12·(L + 2))`. Against the exact area of parabolic peaks 6–40
-/// samples wide, within the bound the host test asserts; a plateau makes it high, a sharper
-/// peak low. What it bounds is the tilt blamed on the rails, so its error only limits how
-/// much of the end tilt is put back. Range: runs up to 2¹⁶ samples; the sum saturates.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub struct RailRun {
-    /// The two samples before this one, newest first (counts); `seen` of them are real.
-    prev: [i32; 2],
-    seen: u8,
-    /// Clipped samples in the current run, and the slope into it (counts per sample).
-    run: u32,
-    slope_in: i32,
-    /// A run that ended at the last sample, waiting for one more to measure its slope out:
-    /// its length (0: none), slope in and the first unclipped value after it.
-    ended_run: u32,
-    ended_slope_in: i32,
-    ended_after: i32,
-    /// Σ of finished runs' reconstructed area, counts·samples.
-    lost: i64,
-}
-
-impl RailRun {
-    /// No run seen.
-    pub const NEW: RailRun = RailRun {
-        prev: [0; 2],
-        seen: 0,
-        run: 0,
-        slope_in: 0,
-        ended_run: 0,
-        ended_slope_in: 0,
-        ended_after: 0,
-        lost: 0,
-    };
-
-    const fn area(run: u32, slope_in: i32, slope_out: i32) -> i64 {
-        let l = run as i128;
-        let a = (slope_in as i128 + slope_out as i128) * l * l * l / (12 * (l + 2));
-        if a > i64::MAX as i128 {
-            i64::MAX
-        } else {
-            a as i64
-        }
-    }
-
-    /// Takes the next raw sample of the axis (counts).
-    pub fn process(&mut self, raw: i16) {
-        let v = raw as i32;
-        let at_rail = raw == i16::MAX || raw == i16::MIN;
-        if self.ended_run > 0 {
-            let after = self.ended_after;
-            let slope_out = if at_rail {
-                (rail_of(after) - after).abs()
-            } else {
-                (after - v).abs()
-            };
-            let a = Self::area(self.ended_run, self.ended_slope_in, slope_out);
-            self.lost = self.lost.saturating_add(a);
-            self.ended_run = 0;
-        }
-        if at_rail {
-            if self.run == 0 {
-                self.slope_in = match self.seen {
-                    2 => (self.prev[0] - self.prev[1]).abs(),
-                    1 => (v - self.prev[0]).abs(),
-                    _ => 0,
-                };
-            }
-            self.run = self.run.saturating_add(1);
-        } else if self.run > 0 {
-            self.ended_run = self.run;
-            self.ended_slope_in = self.slope_in;
-            self.ended_after = v;
-            self.run = 0;
-        }
-        self.prev = [v, self.prev[0]];
-        self.seen = if self.seen < 2 { self.seen + 1 } else { 2 };
-    }
-
-    /// The area above the rail so far, counts·samples, runs still open included (an open
-    /// run's slope out taken equal to its slope in).
-    pub fn lost_counts_samples(&self) -> i64 {
-        let mut lost = self.lost;
-        if self.ended_run > 0 {
-            let out = (rail_of(self.ended_after) - self.ended_after).abs();
-            lost = lost.saturating_add(Self::area(self.ended_run, self.ended_slope_in, out));
-        }
-        if self.run > 0 {
-            lost = lost.saturating_add(Self::area(self.run, self.slope_in, self.slope_in));
-        }
-        lost
-    }
-}
-
-/// The rail nearer a value: the run just left it from that side.
-const fn rail_of(v: i32) -> i32 {
-    if v >= 0 {
-        i16::MAX as i32
-    } else {
-        i16::MIN as i32
     }
 }

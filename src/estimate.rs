@@ -1,0 +1,101 @@
+//! Nothing lost: a length for every stride the detector finds.
+//!
+//! A stride whose length could not be measured (a hole in its movement, a clipped
+//! accelerometer whose loss nothing bounds, a movement beyond its buffer, a model that said
+//! more than a person strides: [`StrideFlags::INVALID`]) still happened, and a foot pod that
+//! dropped it from the distance would lose a metre per hole. It gets the length the walker's
+//! own recent strides give at the same cadence, flagged [`StrideFlags::ESTIMATED`], and
+//! counts in the distance ([`StrideFlags::counts_distance`]).
+//!
+//! **The estimate.** The mean length of the last [`HISTORY`] measured, valid gait cycles (no
+//! stride from or into a rest, no gap): the walker's own strides at the pace of the moment.
+//! Measured as a predictor of every measured stride from the ones before it (`gaitclip
+//! flags`), the mean of the last two had the smallest bias on all three datasets (−0.2 cm
+//! gaitmap, −0.6 pyshoe, +1.2 IPOL) and an RMSE of 21–39 cm that is the strides' own
+//! variability on walks full of turns; matching the cadence (the velocity of kept strides
+//! within 25 % of the duration, times the duration) or taking the last one, the median of
+//! three or the velocity of three were no better on all three (+6.6 cm bias on IPOL for the
+//! cadence match). A hole that swallowed a stance instant makes one "stride" of two cycles:
+//! one stride is what is known of it. With no measured stride yet (a hole before the first)
+//! there is nothing to estimate from: the stride keeps its flags, no length, and the host
+//! counts it as unestimated.
+//!
+//! What each flag's estimate costs against the stride's measured length is measured by
+//! cutting holes into real recordings (`gaitclip flags`, `docs/`).
+//!
+//! Integer and bounded: [`HISTORY`] pairs of `u32`.
+
+use crate::stride::{Stride, StrideFlags, MAX_STRIDE_MM};
+
+/// Measured strides the estimate is the mean of.
+pub const HISTORY: usize = 2;
+
+/// Flags under which a valid stride is not one gait cycle at the walker's pace, and teaches
+/// the estimate nothing.
+const NOT_A_CYCLE: u16 = StrideFlags::FROM_REST | StrideFlags::TO_REST | StrideFlags::GAP;
+
+/// The last measured strides, and the estimate for those that could not be measured.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct LengthEstimator {
+    /// Lengths, mm, of the kept strides (ring, newest at `(next − 1) mod HISTORY`).
+    length_mm: [u32; HISTORY],
+    kept: u8,
+    next: u8,
+}
+
+impl Default for LengthEstimator {
+    fn default() -> Self {
+        Self::new()
+    }
+}
+
+impl LengthEstimator {
+    /// No stride seen.
+    pub const fn new() -> Self {
+        LengthEstimator {
+            length_mm: [0; HISTORY],
+            kept: 0,
+            next: 0,
+        }
+    }
+
+    /// Strides kept so far (at most [`HISTORY`]).
+    pub const fn kept(&self) -> usize {
+        self.kept as usize
+    }
+
+    /// Learns from a measured stride, or estimates one that was not: a stride whose flags
+    /// make its length invalid gets the estimate (see the [module](self)) and
+    /// [`StrideFlags::ESTIMATED`], unless nothing was measured yet. Never panics.
+    pub fn process(&mut self, s: &mut Stride) {
+        let duration = s.end.wrapping_sub(s.start);
+        if duration == 0 || duration > u32::MAX / 2 {
+            return;
+        }
+        if s.flags.valid() {
+            if s.flags.0 & NOT_A_CYCLE == 0 && s.length_mm > 0 {
+                let at = self.next as usize;
+                self.length_mm[at] = s.length_mm;
+                self.next = ((at + 1) % HISTORY) as u8;
+                if (self.kept as usize) < HISTORY {
+                    self.kept += 1;
+                }
+            }
+            return;
+        }
+        if let Some(mm) = self.estimate_mm() {
+            s.length_mm = mm.min(MAX_STRIDE_MM);
+            s.flags.0 |= StrideFlags::ESTIMATED;
+        }
+    }
+
+    /// The estimated length, mm: the mean of the kept strides; `None` with none kept.
+    pub fn estimate_mm(&self) -> Option<u32> {
+        let n = self.kept as usize;
+        if n == 0 {
+            return None;
+        }
+        let sum: u64 = self.length_mm[..n].iter().map(|&l| l as u64).sum();
+        Some(((sum + n as u64 / 2) / n as u64) as u32)
+    }
+}
