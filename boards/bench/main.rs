@@ -42,7 +42,8 @@ use static_cell::ConstStaticCell;
 #[cfg(armv6m)]
 const MOVEMENT_SAMPLES: usize = 256;
 #[cfg(not(armv6m))]
-const MOVEMENT_SAMPLES: usize = gaitclip::stride::MAX_MOVEMENT_SAMPLES;
+const MOVEMENT_SAMPLES: usize =
+    gaitclip::stride::movement_samples(trace::RATE_MILLIHERTZ.div_ceil(1000));
 
 const fn unwrap<T: Copy>(v: Option<T>) -> T {
     match v {

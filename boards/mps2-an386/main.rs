@@ -14,7 +14,6 @@ use gaitclip_board::{replay_app, Steps};
 
 use cortex_m_rt::{entry, exception};
 use defmt_semihosting as _;
-use gaitclip::stride::MAX_MOVEMENT_SAMPLES;
 
 use cmsdk_timer::CmsdkTimer;
 use gaitclip::pipeline::Pipeline;
@@ -26,9 +25,11 @@ const CYCLES_PER_US: u32 = 25;
 /// The pipeline, built at compile time into .data: no copy of it ever sits on the stack
 /// (moving 8–12 KiB through the stack is more than a 16 KiB part can spare), and the stack
 /// holds only what one sample's processing needs.
-static PIPELINE: ConstStaticCell<Pipeline<Steps<MAX_MOVEMENT_SAMPLES>>> = ConstStaticCell::new(
-    Pipeline::with_detector(replay_app::CONFIG, Steps::new(&replay_app::CONFIG)),
-);
+static PIPELINE: ConstStaticCell<Pipeline<Steps<{ replay_app::MOVEMENT_SAMPLES }>>> =
+    ConstStaticCell::new(Pipeline::with_detector(
+        replay_app::CONFIG,
+        Steps::new(&replay_app::CONFIG),
+    ));
 
 #[entry]
 fn main() -> ! {

@@ -45,9 +45,9 @@ use embassy_sync::signal::Signal;
 use embassy_time::{Duration, Instant, Ticker, Timer};
 use gaitclip::mpu6050::{Address, Mpu6050};
 use gaitclip::pipeline::Pipeline;
-use gaitclip::stride::MAX_MOVEMENT_SAMPLES;
 use gaitclip_board::imu_sampler::{BusRecovery, Counters, ImuSampler, Item, ReadMode};
 use gaitclip_board::live_app::{self, Drain, SpinDelay, Watchdog, WATCHDOG_TICK_MS};
+use gaitclip_board::live_settings::MOVEMENT_SAMPLES;
 use gaitclip_board::live_settings::{CONFIG, FIFO_BATCH, QUEUE_LEN, RATE, SENSOR};
 use gaitclip_board::rsc_gatt::{self, battery_percent, PodLink};
 use gaitclip_board::sleep::{SleepPolicy, SLEEP};
@@ -86,7 +86,7 @@ bind_interrupts!(struct Irqs {
 /// The sampler's executor, on a software interrupt above thread mode.
 static SAMPLER_EXECUTOR: InterruptExecutor = InterruptExecutor::new();
 static QUEUE: ConstStaticCell<Queue<Item, QUEUE_LEN>> = ConstStaticCell::new(Queue::new());
-static PIPELINE: ConstStaticCell<Pipeline<Steps<MAX_MOVEMENT_SAMPLES>>> =
+static PIPELINE: ConstStaticCell<Pipeline<Steps<MOVEMENT_SAMPLES>>> =
     ConstStaticCell::new(Pipeline::with_detector(CONFIG, Steps::new(&CONFIG)));
 /// Raised by the sampler after every data-ready pulse it handled.
 static QUEUED: Signal<CriticalSectionRawMutex, ()> = Signal::new();
@@ -270,7 +270,7 @@ fn publish(sampler: &ImuSampler<Bus, SpinDelay>) {
 /// The pipeline and the logs; every stride to the foot pod.
 #[embassy_executor::task]
 async fn pipeline_task(
-    pipeline: &'static mut Pipeline<Steps<MAX_MOVEMENT_SAMPLES>>,
+    pipeline: &'static mut Pipeline<Steps<MOVEMENT_SAMPLES>>,
     mut consumer: Consumer<'static, Item>,
     mut log: StrideLog,
     mut serial: Serial,

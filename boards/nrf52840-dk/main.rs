@@ -32,7 +32,7 @@ use defmt_rtt as _;
 use embedded_hal::i2c::{ErrorType, I2c, Operation, SevenBitAddress};
 use gaitclip::mpu6050::{Address, Mpu6050};
 use gaitclip::pipeline::Pipeline;
-use gaitclip::stride::MAX_MOVEMENT_SAMPLES;
+use gaitclip_board::live_settings::MOVEMENT_SAMPLES;
 use heapless::spsc::Queue;
 use nrf52840_hal::{
     self as hal,
@@ -117,7 +117,7 @@ type WatchdogTimer = Timer<TIMER1, Periodic>;
 static WATCHDOG: Mutex<RefCell<Option<(WatchdogTimer, Watchdog)>>> = Mutex::new(RefCell::new(None));
 static QUEUE: ConstStaticCell<Queue<Item, QUEUE_LEN>> = ConstStaticCell::new(Queue::new());
 /// The pipeline's configuration.
-static PIPELINE: ConstStaticCell<Pipeline<Steps<MAX_MOVEMENT_SAMPLES>>> =
+static PIPELINE: ConstStaticCell<Pipeline<Steps<MOVEMENT_SAMPLES>>> =
     ConstStaticCell::new(Pipeline::with_detector(CONFIG, Steps::new(&CONFIG)));
 
 #[entry]

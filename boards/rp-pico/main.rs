@@ -31,7 +31,7 @@ use embedded_hal::i2c::{ErrorType, I2c, Operation, SevenBitAddress};
 use fugit::{HertzU32, RateExtU32};
 use gaitclip::mpu6050::{Address, Mpu6050};
 use gaitclip::pipeline::Pipeline;
-use gaitclip::stride::MAX_MOVEMENT_SAMPLES;
+use gaitclip_board::live_settings::MOVEMENT_SAMPLES;
 use heapless::spsc::Queue;
 use panic_probe as _;
 use rp2040_hal::{
@@ -126,7 +126,7 @@ static SLEEP_CLOCK: Mutex<RefCell<Option<(Timer, u64)>>> = Mutex::new(RefCell::n
 const SETTLE: u32 = SleepPolicy::settle_samples(RATE, &SLEEP);
 static QUEUE: ConstStaticCell<Queue<Item, QUEUE_LEN>> = ConstStaticCell::new(Queue::new());
 /// The pipeline's configuration.
-static PIPELINE: ConstStaticCell<Pipeline<Steps<MAX_MOVEMENT_SAMPLES>>> =
+static PIPELINE: ConstStaticCell<Pipeline<Steps<MOVEMENT_SAMPLES>>> =
     ConstStaticCell::new(Pipeline::with_detector(CONFIG, Steps::new(&CONFIG)));
 
 #[hal::entry]

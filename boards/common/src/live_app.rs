@@ -303,7 +303,12 @@ impl Drain {
             match item {
                 Item::Sample(_) if self.samples == self.next_status => {
                     self.next_status = self.next_status.wrapping_add(self.status_every_samples);
-                    log.summary(self.samples, &counters(), serial);
+                    log.summary(
+                        self.samples,
+                        &counters(),
+                        &pipeline.clipped_samples(),
+                        serial,
+                    );
                 }
                 Item::Gap(n) => log.gap(n, pipeline.hole_kind(n), serial),
                 Item::Woke(n) => log.woke(n, serial),

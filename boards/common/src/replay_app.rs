@@ -68,6 +68,9 @@ const ACCEL: AccelRange = unwrap(AccelRange::from_afs_sel(trace::ACCEL_AFS_SEL))
 const GYRO: GyroRange = unwrap(GyroRange::from_fs_sel(trace::GYRO_FS_SEL));
 /// The pipeline's configuration for the stored trace.
 pub const CONFIG: Config = crate::live_settings::config(RATE, ACCEL, GYRO);
+/// The movement buffer: [`gaitclip::stride::MAX_MOVEMENT_MS`] at the trace's rate.
+pub const MOVEMENT_SAMPLES: usize =
+    gaitclip::stride::movement_samples(trace::RATE_MILLIHERTZ.div_ceil(1000));
 const SENSOR: mpu6050::Config =
     crate::live_settings::sensor_config((trace::RATE_MILLIHERTZ / 1000) as u16, ACCEL, GYRO);
 
@@ -230,7 +233,12 @@ fn finish<D: StepDetector>(pipeline: &mut Pipeline<D>, log: &mut StrideLog, samp
     while let Some(stride) = pipeline.finish() {
         log.stride(&stride, serial);
     }
-    log.summary(samples, &LINK.counters(), serial);
+    log.summary(
+        samples,
+        &LINK.counters(),
+        &pipeline.clipped_samples(),
+        serial,
+    );
     let (used, size) = crate::stack_paint::used_and_size();
     defmt::println!("stack used={=u32} of {=u32} bytes", used, size);
     debug::exit(EXIT_SUCCESS);

@@ -13,7 +13,7 @@
 //! | 1 | flags: bit 0 stride length present, bit 1 total distance present, bit 2 running | | [`Gait::Running`] sets bit 2 |
 //! | 2 | instantaneous speed | 1/256 m/s | [`gaitclip::gait::GaitParameters::gait_velocity_mm_s`] |
 //! | 1 | instantaneous cadence | steps/min | [`gaitclip::gait::GaitParameters::cadence_spm`] (saturated at 255) |
-//! | 2 | instantaneous stride length (if bit 0) | cm | [`Stride::length_mm`], only for a valid stride |
+//! | 2 | instantaneous stride length (if bit 0) | cm | [`Stride::length_mm`], for a stride that counts in the distance (measured, or estimated) |
 //! | 4 | total distance (if bit 1) | dm | [`FootPod::total_distance_dm`] |
 //!
 //! A stride (two steps, heel-strike to heel-strike of one foot) is what RSC's "stride length"
@@ -93,7 +93,7 @@ impl Measurement {
     /// The measurement of `stride`, with the total distance after it.
     pub fn of_stride(stride: &Stride, total_distance_dm: u32) -> Self {
         let g = &stride.gait;
-        let has_length = stride.flags.valid() && stride.length_mm > 0;
+        let has_length = stride.flags.counts_distance() && stride.length_mm > 0;
         Measurement {
             // mm/s · 256/1000, rounded: at most 65 535 mm/s → 16 777 < 2¹⁶.
             speed_256ths_m_s: ((g.gait_velocity_mm_s as u32 * 256 + 500) / 1000) as u16,
@@ -210,9 +210,10 @@ impl FootPod {
         (self.total_mm / 100) as u32
     }
 
-    /// A stride at `now_ms`: adds its length when it has one, and returns its measurement.
+    /// A stride at `now_ms`: adds its length when it has one (measured, or estimated where
+    /// it could not be measured), and returns its measurement.
     pub fn stride(&mut self, stride: &Stride, now_ms: u32) -> Measurement {
-        if stride.flags.valid() {
+        if stride.flags.counts_distance() {
             self.total_mm = self.total_mm.saturating_add(stride.length_mm as u64);
         }
         self.last_stride_ms = Some(now_ms);

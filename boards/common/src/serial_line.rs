@@ -11,7 +11,7 @@
 //! # still: gyro_bias_mdps=-1220,305,61 gravity_mg=1003
 //! 0,5120,1362,1105,420,150,380,155,3,4,1,725,380,656,1233,109,131,-215,unknown
 //! # hole samples=12 filled: a stride whose movement it falls in is a gap stride (flag 64), without a length
-//! # status samples=24000 strides=96 distance_mm=131012 bus_errors=0 restarts=0 fifo_overflows=0 silences=0 overruns=0 lost_samples=0 sleeps=0 slept_periods=0
+//! # status samples=24000 strides=96 distance_mm=131012 bus_errors=0 restarts=0 fifo_overflows=0 silences=0 overruns=0 lost_samples=0 sleeps=0 slept_periods=0 estimated=0 clipped=0,0,3,0,0,0
 //! # sleep still_ms=10000 wake_mhz=5000 sensor_ua=20: waiting for motion
 //! # wake unsampled_ms=2310 detection restarts: a step the wake-up cut into is a gap stride (flag 64)
 //! ```
@@ -39,7 +39,7 @@ use crate::imu_sampler::Counters;
 
 /// Longest line this module writes, with its `\r\n` (the status line with every counter
 /// at its maximum): the size of a board's line buffer.
-pub const MAX_LINE: usize = 256;
+pub const MAX_LINE: usize = 384;
 
 /// The CSV header line.
 pub const HEADER: &str = "index,t_ms,length_mm,duration_ms,stance_ms,push_off_ms,swing_ms,heel_strike_ms,climb_mm,flags,valid,stance_time_ms,swing_time_ms,stance_permille,gait_velocity_mm_s,cadence_spm,max_sensor_lift_mm,turning_angle_cdeg,gait";
@@ -103,11 +103,13 @@ pub fn status(
     samples: u32,
     strides: u32,
     distance_mm: u64,
+    estimated: u32,
+    clipped: &[u32; 6],
     c: &Counters,
 ) -> fmt::Result {
     write!(
         out,
-        "# status samples={} strides={} distance_mm={} bus_errors={} restarts={} fifo_overflows={} silences={} overruns={} lost_samples={} sleeps={} slept_periods={}\r\n",
+        "# status samples={} strides={} distance_mm={} bus_errors={} restarts={} fifo_overflows={} silences={} overruns={} lost_samples={} sleeps={} slept_periods={} estimated={} clipped={},{},{},{},{},{}\r\n",
         samples,
         strides,
         distance_mm,
@@ -118,6 +120,13 @@ pub fn status(
         c.overruns,
         c.lost_samples,
         c.sleeps,
-        c.slept_periods
+        c.slept_periods,
+        estimated,
+        clipped[0],
+        clipped[1],
+        clipped[2],
+        clipped[3],
+        clipped[4],
+        clipped[5]
     )
 }

@@ -29,7 +29,10 @@ impl Write for NoSerial {
 pub struct StrideLog {
     rate: SampleRate,
     strides: u32,
+    /// Summed length of the strides that count in the distance (measured or estimated).
     distance_mm: u64,
+    /// Strides whose length is the estimate ([`gaitclip::estimate`]).
+    estimated: u32,
 }
 
 impl StrideLog {
@@ -39,6 +42,7 @@ impl StrideLog {
             rate,
             strides: 0,
             distance_mm: 0,
+            estimated: 0,
         }
     }
 
@@ -61,7 +65,12 @@ impl StrideLog {
     pub fn stride(&mut self, s: &Stride, serial: &mut impl Write) {
         let ms = |a: u32, b: u32| self.rate.ms_of_samples(b.wrapping_sub(a));
         self.strides += 1;
-        self.distance_mm += s.length_mm as u64;
+        if s.flags.counts_distance() {
+            self.distance_mm += s.length_mm as u64;
+        }
+        if s.flags.has(gaitclip::stride::StrideFlags::ESTIMATED) {
+            self.estimated += 1;
+        }
         defmt::println!(
             "stride {=u32} t={=u32} dur={=u32} len={=u32} climb={=i32} phases={=u32}/{=u32}/{=u32}/{=u32} ms flags={=u16} idx={=u32},{=u32},{=u32},{=u32},{=u32} gait={=u16},{=u16},{=u16},{=u16},{=u16},{=u16},{=i16} {=str}",
             s.index,
@@ -191,9 +200,12 @@ impl StrideLog {
     }
 
     /// Logs the status (periodically, and at the end of a run).
-    pub fn summary(&self, samples: u32, c: &Counters, serial: &mut impl Write) {
+    ///
+    /// `clipped`: samples at a rail per axis (accelerometer x, y, z, gyroscope x, y, z;
+    /// [`gaitclip::pipeline::Pipeline::clipped_samples`]).
+    pub fn summary(&self, samples: u32, c: &Counters, clipped: &[u32; 6], serial: &mut impl Write) {
         defmt::println!(
-            "summary strides={=u32} distance_mm={=u64} samples={=u32} overruns={=u32} bus_errors={=u32} restarts={=u32} fifo_overflows={=u32} silences={=u32} lost_samples={=u32} sleeps={=u32} slept_periods={=u32}",
+            "summary strides={=u32} distance_mm={=u64} samples={=u32} overruns={=u32} bus_errors={=u32} restarts={=u32} fifo_overflows={=u32} silences={=u32} lost_samples={=u32} sleeps={=u32} slept_periods={=u32} estimated={=u32} clipped={=u32},{=u32},{=u32},{=u32},{=u32},{=u32}",
             self.strides,
             self.distance_mm,
             samples,
@@ -204,8 +216,23 @@ impl StrideLog {
             c.silences,
             c.lost_samples,
             c.sleeps,
-            c.slept_periods
+            c.slept_periods,
+            self.estimated,
+            clipped[0],
+            clipped[1],
+            clipped[2],
+            clipped[3],
+            clipped[4],
+            clipped[5]
         );
-        let _ = serial_line::status(serial, samples, self.strides, self.distance_mm, c);
+        let _ = serial_line::status(
+            serial,
+            samples,
+            self.strides,
+            self.distance_mm,
+            self.estimated,
+            clipped,
+            c,
+        );
     }
 }
