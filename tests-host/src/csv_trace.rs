@@ -114,6 +114,35 @@ pub fn read(path: &Path, rate_hz: Option<f64>) -> Result<Trace, CsvError> {
         samples,
         rate_hz,
         repeated,
+        given: meta_ranges(path)?,
+    })
+}
+
+/// The nominal ranges `acc_range_g` and `gyro_range_dps` of a `meta.json` beside the file,
+/// where it gives them.
+fn meta_ranges(csv: &Path) -> Result<crate::rails::GivenRanges, CsvError> {
+    let meta = csv.with_file_name("meta.json");
+    let Ok(text) = fs::read_to_string(&meta) else {
+        return Ok(Default::default());
+    };
+    let v: serde_json::Value = serde_json::from_str(&text).map_err(|e| CsvError::Meta {
+        path: meta.clone(),
+        message: e.to_string(),
+    })?;
+    let field = |name: &str| match v.get(name) {
+        None => Ok(None),
+        Some(r) => r
+            .as_f64()
+            .filter(|r| *r > 0.0)
+            .map(Some)
+            .ok_or(CsvError::Meta {
+                path: meta.clone(),
+                message: format!("{name} is not a positive number: {r}"),
+            }),
+    };
+    Ok(crate::rails::GivenRanges {
+        acc_g: field("acc_range_g")?,
+        gyro_dps: field("gyro_range_dps")?,
     })
 }
 

@@ -10,9 +10,10 @@
 //! detector's energy, whose arithmetic [`energy`] checks against the same formula in `f64`
 //! (`tests/fixed_point.rs`).
 
+use gaitclip::clipping::SHAPED_RUN_MIN;
 use gaitclip::cycle::{Calibration, CycleConfig, SIGMA_A_MMPS2, SIGMA_W_MRADPS};
 use gaitclip::pipeline::{Config, Pipeline};
-use gaitclip::sample::RawSample;
+use gaitclip::sample::{AxisRails, RawSample};
 use gaitclip::stride::{Stride, StrideFlags};
 use nalgebra::{UnitQuaternion, Vector3};
 
@@ -160,8 +161,32 @@ pub fn zupt_m(run: &CoreRun, k: usize) -> Result<f64, Skipped> {
     let mut q = UnitQuaternion::rotation_between(&up0, &Vector3::z()).ok_or(Skipped::Missing)?;
     let mut v = rolling(&q, omega(&sample(i0)?, cal0.gyro_bias));
     let mut p = Vector3::zeros();
+    let config_rails = run.config.rails;
     let mut rails = [RailRunF64::default(); 3];
     let (mut clipped, mut s1, mut s2) = (0u64, 0f64, 0f64);
+    // The accelerometer's rails: per axis the run's direction and first sample; the steps of
+    // shaped runs (m/s, with their centre) and the single samples' directions.
+    let mut accel_runs = [RailRunF64::default(); 3];
+    let mut accel_dir = [(Vector3::zeros(), 0f64); 3];
+    let mut steps: Vec<(Vector3<f64>, f64)> = Vec::new();
+    let mut singles: Vec<(Vector3<f64>, f64)> = Vec::new();
+    let (mut min_rail, mut climbs) = (f64::INFINITY, 0f64);
+    let to_mps = G / g_counts * dt;
+    let mut book = |k: usize,
+                    (len, area, climb): Done,
+                    (dir, first): (Vector3<f64>, f64),
+                    steps: &mut Vec<(Vector3<f64>, f64)>,
+                    singles: &mut Vec<(Vector3<f64>, f64)>| {
+        if len >= SHAPED_RUN_MIN {
+            steps.push((dir * (area * to_mps), first + (len as f64 - 1.0) / 2.0));
+        } else {
+            for j in 0..len {
+                singles.push((dir, first + j as f64));
+            }
+            min_rail = min_rail.min(config_rails.accel[k].min_magnitude() as f64);
+            climbs += climb * len as f64;
+        }
+    };
     for (c, i) in (i0 + 1..=i1).enumerate() {
         let x = sample(i)?;
         q *= UnitQuaternion::from_scaled_axis(omega(&x, cal0.gyro_bias) * dt);
@@ -170,10 +195,28 @@ pub fn zupt_m(run: &CoreRun, k: usize) -> Result<f64, Skipped> {
         let v_prev = v;
         v += a * dt;
         p += (v_prev + v) * (dt / 2.0);
-        for (r, &g) in rails.iter_mut().zip(x.gyro.iter()) {
-            r.process(g);
+        let m = q.to_rotation_matrix();
+        for k in 0..3 {
+            let raw = x.accel[k];
+            let r = config_rails.accel[k];
+            // A run this sample completes was booked with its own direction before a run
+            // this sample starts takes the next.
+            if let Some(done) = accel_runs[k].process(raw, r) {
+                book(k, done, accel_dir[k], &mut steps, &mut singles);
+            }
+            if r.clipped(raw) && accel_runs[k].run == 1 {
+                let sign = if raw > 0 { 1.0 } else { -1.0 };
+                accel_dir[k] = (m.matrix().column(k) * sign, (c + 1) as f64);
+            }
         }
-        if x.gyro_saturated() {
+        for ((r, &g), &rails) in rails
+            .iter_mut()
+            .zip(x.gyro.iter())
+            .zip(config_rails.gyro.iter())
+        {
+            r.process(g, rails);
+        }
+        if config_rails.gyro_clipped(&x) {
             let c = (c + 1) as f64;
             clipped += 1;
             s1 += c;
@@ -182,12 +225,40 @@ pub fn zupt_m(run: &CoreRun, k: usize) -> Result<f64, Skipped> {
     }
     let n = (i1 - i0) as f64;
     let v_end = rolling(&q, omega(&sample(i1)?, cal1.gyro_bias));
+    // Accelerometer: runs still open at the end booked as they stand, then each loss put
+    // back as a velocity step where it happened (a step at sample c moves the trapezoidal
+    // position by (N − c + ½)·dt).
+    for k in 0..3 {
+        if let Some(done) = accel_runs[k].pending(config_rails.accel[k]) {
+            book(k, done, accel_dir[k], &mut steps, &mut singles);
+        }
+    }
+    for &(d, c) in &steps {
+        v += d;
+        p += d * ((n - c + 0.5) * dt);
+    }
+    if !singles.is_empty() {
+        let u: Vector3<f64> = singles.iter().map(|s| s.0).sum();
+        // The core takes the mean climb in whole counts.
+        let cap = (climbs / singles.len() as f64).floor().min(min_rail) * to_mps;
+        let alpha = ((v_end - v).dot(&u) / u.dot(&u)).max(0.0).min(cap);
+        for &(dir, c) in &singles {
+            v += dir * alpha;
+            p += dir * (alpha * (n - c + 0.5) * dt);
+        }
+    }
     p -= (v - v_end) * (n * dt / 2.0);
     if clipped > 0 {
         let level = q * up1;
         let (norm, lxy) = (level.norm(), level.xy().norm());
         if norm > 0.0 && lxy > 0.0 {
-            let lost: f64 = rails.iter().map(|r| r.lost()).sum::<f64>() * rad * dt;
+            let lost: f64 = rails
+                .iter()
+                .zip(config_rails.gyro.iter())
+                .map(|(r, &rails)| r.lost(rails))
+                .sum::<f64>()
+                * rad
+                * dt;
             let h = if lxy / norm > lost {
                 level.xy() * (lost / lxy)
             } else {
@@ -201,7 +272,7 @@ pub fn zupt_m(run: &CoreRun, k: usize) -> Result<f64, Skipped> {
     Ok(p.xy().norm())
 }
 
-/// [`gaitclip::zupt::RailRun`] in `f64`: the parabola's area above the rail per clipped
+/// [`gaitclip::clipping::RailRun`] in `f64`: the parabola's area above the rail per clipped
 /// run, counts·samples.
 #[derive(Clone, Copy, Debug, Default)]
 struct RailRunF64 {
@@ -209,9 +280,15 @@ struct RailRunF64 {
     seen: u8,
     run: u32,
     slope_in: f64,
-    ended: Option<(u32, f64, f64)>,
+    before: f64,
+    /// A run waiting for its slope out: length, slope in, value before, value after.
+    ended: Option<(u32, f64, f64, f64)>,
     lost: f64,
 }
+
+/// A completed run: length, area above the rail, and the mean climb of its neighbours to
+/// the rail (whole counts, as the core's).
+type Done = (u32, f64, f64);
 
 impl RailRunF64 {
     fn area(run: u32, s_in: f64, s_out: f64) -> f64 {
@@ -219,24 +296,32 @@ impl RailRunF64 {
         (s_in + s_out) * l.powi(3) / (12.0 * (l + 2.0))
     }
 
-    fn rail(v: f64) -> f64 {
+    fn rail(v: f64, rails: AxisRails) -> f64 {
         if v >= 0.0 {
-            i16::MAX as f64
+            rails.high as f64
         } else {
-            i16::MIN as f64
+            rails.low as f64
         }
     }
 
-    fn process(&mut self, raw: i16) {
+    fn climb(rail: f64, before: f64, after: f64) -> f64 {
+        (((rail - before).abs() + (rail - after).abs()) / 2.0).floor()
+    }
+
+    /// The run this sample completed.
+    fn process(&mut self, raw: i16, rails: AxisRails) -> Option<Done> {
         let v = raw as f64;
-        let at_rail = raw == i16::MAX || raw == i16::MIN;
-        if let Some((run, s_in, after)) = self.ended.take() {
+        let at_rail = rails.clipped(raw);
+        let mut done = None;
+        if let Some((run, s_in, before, after)) = self.ended.take() {
             let s_out = if at_rail {
-                (Self::rail(after) - after).abs()
+                (Self::rail(after, rails) - after).abs()
             } else {
                 (after - v).abs()
             };
-            self.lost += Self::area(run, s_in, s_out);
+            let a = Self::area(run, s_in, s_out);
+            self.lost += a;
+            done = Some((run, a, Self::climb(Self::rail(after, rails), before, after)));
         }
         if at_rail {
             if self.run == 0 {
@@ -245,25 +330,39 @@ impl RailRunF64 {
                     1 => (v - self.prev[0]).abs(),
                     _ => 0.0,
                 };
+                self.before = if self.seen > 0 { self.prev[0] } else { v };
             }
             self.run += 1;
         } else if self.run > 0 {
-            self.ended = Some((self.run, self.slope_in, v));
+            self.ended = Some((self.run, self.slope_in, self.before, v));
             self.run = 0;
         }
         self.prev = [v, self.prev[0]];
         self.seen = (self.seen + 1).min(2);
+        done
     }
 
-    fn lost(&self) -> f64 {
-        let mut lost = self.lost;
-        if let Some((run, s_in, after)) = self.ended {
-            lost += Self::area(run, s_in, (Self::rail(after) - after).abs());
+    fn pending(&self, rails: AxisRails) -> Option<Done> {
+        if let Some((run, s_in, before, after)) = self.ended {
+            let rail = Self::rail(after, rails);
+            return Some((
+                run,
+                Self::area(run, s_in, (rail - after).abs()),
+                Self::climb(rail, before, after),
+            ));
         }
-        if self.run > 0 {
-            lost += Self::area(self.run, self.slope_in, self.slope_in);
-        }
-        lost
+        (self.run > 0).then(|| {
+            let rail = Self::rail(self.prev[0], rails);
+            (
+                self.run,
+                Self::area(self.run, self.slope_in, self.slope_in),
+                Self::climb(rail, self.before, self.before),
+            )
+        })
+    }
+
+    fn lost(&self, rails: AxisRails) -> f64 {
+        self.lost + self.pending(rails).map_or(0.0, |p| p.1)
     }
 }
 
@@ -273,6 +372,7 @@ pub fn cycle_config(config: &Config) -> CycleConfig {
         config.rate,
         config.accel,
         config.gyro,
+        config.rails,
         config.phases,
         config.sensor_height_um,
     )

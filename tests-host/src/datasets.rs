@@ -180,6 +180,7 @@ pub fn load(dir: &Path) -> Result<Dataset> {
     let trials = match meta.name.as_str() {
         "gaitmap_walk" | "pyshoe_vicon" => load_strides(dir, &meta.name)?,
         "ipol_gait_events" => load_ipol(dir)?,
+        "esangeni_run" => load_unlabelled(dir)?,
         other => bail!("{}: unknown dataset {other:?}", dir.display()),
     };
     Ok(Dataset {
@@ -265,6 +266,35 @@ fn load_strides(dir: &Path, name: &str) -> Result<Vec<Trial>> {
         });
     }
     Ok(trials)
+}
+
+/// A dataset without per-stride truth (`esangeni_run`): every `<trial>.csv` of the folder,
+/// whole, with no references.
+fn load_unlabelled(dir: &Path) -> Result<Vec<Trial>> {
+    let mut names: Vec<String> = std::fs::read_dir(dir)
+        .with_context(|| format!("{}", dir.display()))?
+        .filter_map(|e| e.ok())
+        .filter_map(|e| {
+            let n = e.file_name().to_string_lossy().into_owned();
+            n.strip_suffix(".csv").map(str::to_owned)
+        })
+        .collect();
+    names.sort();
+    Ok(names
+        .into_iter()
+        .map(|trial| Trial {
+            csv: dir.join(format!("{trial}.csv")),
+            name: trial,
+            references: Vec::new(),
+            span: (0, u32::MAX),
+            span_s: None,
+            stance: None,
+            positions: None,
+            unscored_s: None,
+            height_m: None,
+            distance_m: None,
+        })
+        .collect())
 }
 
 fn load_ipol(dir: &Path) -> Result<Vec<Trial>> {

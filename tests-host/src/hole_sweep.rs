@@ -211,39 +211,7 @@ fn holes_in(s: &Stride, p: Pattern) -> Vec<u32> {
 pub fn cost(w: &Walk, p: Pattern) -> Cost {
     let mut total = Cost::default();
     for parity in 0..2 {
-        let cut: Vec<usize> = w
-            .walking
-            .iter()
-            .copied()
-            .enumerate()
-            .filter(|(k, _)| k % 2 == parity)
-            .map(|(_, i)| i)
-            .collect();
-        let mut lost_at: Vec<u32> = cut
-            .iter()
-            .flat_map(|&i| holes_in(&w.strides[i], p))
-            .collect();
-        lost_at.sort_unstable();
-        // Rows kept and the gaps before them, in the core's numbering (which counts the
-        // lost samples, so it is the uncut trace's).
-        let mut counts = Vec::with_capacity(w.counts.len());
-        let mut gaps = Vec::new();
-        let mut next = lost_at.iter().peekable();
-        let mut n = 0u32;
-        while (n as usize) < w.counts.len() {
-            if next.next_if(|&&a| a == n).is_some() {
-                let missing = p.len.min(w.counts.len() as u32 - n);
-                gaps.push(Gap {
-                    before: counts.len(),
-                    missing,
-                });
-                n += missing;
-                continue;
-            }
-            counts.push(w.counts[n as usize]);
-            n += 1;
-        }
-        let got = replay::core_strides_gapped(&counts, &gaps, w.config);
+        let (cut, got) = cut_replay(w, p, parity);
         for &i in &cut {
             total.add(compare(&w.strides[i], &got, w.period_ms));
         }
@@ -251,11 +219,48 @@ pub fn cost(w: &Walk, p: Pattern) -> Cost {
     total
 }
 
-/// One cut stride against the cut replay's strides.
-fn compare(want: &Stride, got: &[Stride], period_ms: f64) -> Cost {
-    let mut c = Cost::default();
-    // The stride of the cut replay overlapping the uncut one's movement most; lost (missed
-    // or split) unless the overlap is at least half of the longer of the two.
+/// Every other walking stride of `w` (`parity` 0 or 1) cut by pattern `p`, and the strides of
+/// the cut replay (with `w.config`): the indices of the cut strides into `w.strides`, and
+/// what the core reported.
+pub fn cut_replay(w: &Walk, p: Pattern, parity: usize) -> (Vec<usize>, Vec<Stride>) {
+    let cut: Vec<usize> = w
+        .walking
+        .iter()
+        .copied()
+        .enumerate()
+        .filter(|(k, _)| k % 2 == parity)
+        .map(|(_, i)| i)
+        .collect();
+    let mut lost_at: Vec<u32> = cut
+        .iter()
+        .flat_map(|&i| holes_in(&w.strides[i], p))
+        .collect();
+    lost_at.sort_unstable();
+    // Rows kept and the gaps before them, in the core's numbering (which counts the
+    // lost samples, so it is the uncut trace's).
+    let mut counts = Vec::with_capacity(w.counts.len());
+    let mut gaps = Vec::new();
+    let mut next = lost_at.iter().peekable();
+    let mut n = 0u32;
+    while (n as usize) < w.counts.len() {
+        if next.next_if(|&&a| a == n).is_some() {
+            let missing = p.len.min(w.counts.len() as u32 - n);
+            gaps.push(Gap {
+                before: counts.len(),
+                missing,
+            });
+            n += missing;
+            continue;
+        }
+        counts.push(w.counts[n as usize]);
+        n += 1;
+    }
+    (cut, replay::core_strides_gapped(&counts, &gaps, w.config))
+}
+
+/// The stride of `got` overlapping `want`'s movement most, if it overlaps at least half of
+/// the longer of the two (else the stride was lost: missed or split).
+pub fn matching_stride<'a>(want: &Stride, got: &'a [Stride]) -> Option<&'a Stride> {
     let m = got
         .iter()
         .map(|g| {
@@ -270,6 +275,17 @@ fn compare(want: &Stride, got: &[Stride], period_ms: f64) -> Cost {
         Some((ov, g))
             if 2 * ov >= (want.end - want.heel_off).max(g.end.saturating_sub(g.heel_off)) =>
         {
+            Some(g)
+        }
+        _ => None,
+    }
+}
+
+/// One cut stride against the cut replay's strides.
+fn compare(want: &Stride, got: &[Stride], period_ms: f64) -> Cost {
+    let mut c = Cost::default();
+    match matching_stride(want, got) {
+        Some(g) => {
             if !g.flags.valid() {
                 c.invalid += 1;
                 return c;
@@ -285,7 +301,7 @@ fn compare(want: &Stride, got: &[Stride], period_ms: f64) -> Cost {
                 .push(g.heel_off.abs_diff(want.heel_off) as f64 * period_ms);
             c.edges_ms.push(g.end.abs_diff(want.end) as f64 * period_ms);
         }
-        _ => c.lost += 1,
+        None => c.lost += 1,
     }
     c
 }

@@ -468,6 +468,7 @@ pub fn decode(path: &Path, bytes: &[u8], rate_hz: Option<f64>) -> Result<Trace, 
         samples,
         rate_hz,
         repeated,
+        given: Default::default(),
     })
 }
 

@@ -13,13 +13,14 @@ use gaitclip::stride::{Stride, StrideFlags};
 use serde::Serialize;
 
 use crate::clock::{Gap, SampleClock, TimeGoesBack};
+use crate::rails::{self, AxisReport, RailsReport};
 use crate::trace::{Ranges, Trace};
 
 /// Why a trace cannot be replayed.
 #[derive(Debug, thiserror::Error)]
 pub enum ReplayError {
     /// The rate is outside what the core supports.
-    #[error("sample rate {0} Hz is outside 100–1000 Hz")]
+    #[error("sample rate {0} Hz is outside 50–1000 Hz")]
     Rate(f64),
     /// The trace has no samples.
     #[error("no samples")]
@@ -59,8 +60,19 @@ pub struct Summary {
     pub bridged_strides: usize,
     /// Gap strides.
     pub gap_strides: usize,
-    /// Summed length of the valid strides, m.
+    /// Strides whose length was not measured and is estimated from the strides before them
+    /// (they count in the distance).
+    pub estimated_strides: usize,
+    /// Strides with no length at all: not measured, and nothing measured before them to
+    /// estimate from (left out of the distance).
+    pub unestimated_strides: usize,
+    /// Summed length of the strides that have one (measured, or estimated), m: what the
+    /// foot pod's total shows.
     pub distance_m: f64,
+    /// Of it, the estimated strides', m.
+    pub estimated_distance_m: f64,
+    /// Per axis, its rails (learnt or nominal) and the samples at them.
+    pub rails: Vec<AxisReport>,
     /// The nominal rate (`--rate`, `meta.json`, or the stamps), Hz.
     pub nominal_rate_hz: f64,
     /// The sensor clock recovered from the stamps: rate, Hz…
@@ -91,19 +103,33 @@ impl Summary {
         self.valid_strides += o.valid_strides;
         self.bridged_strides += o.bridged_strides;
         self.gap_strides += o.gap_strides;
+        self.estimated_strides += o.estimated_strides;
+        self.unestimated_strides += o.unestimated_strides;
         self.distance_m += o.distance_m;
+        self.estimated_distance_m += o.estimated_distance_m;
+        if self.rails.is_empty() {
+            self.rails = o.rails.clone();
+        } else {
+            for (a, b) in self.rails.iter_mut().zip(&o.rails) {
+                a.clipped += b.clipped;
+            }
+        }
         self.retimed_stamps += o.retimed_stamps;
     }
 
     /// The summary as one line of text.
     pub fn line(&self) -> String {
         let mut s = format!(
-            "summary: {} strides ({} valid, {} bridged, {} gap), {:.3} m; {} samples read, {} repeated dropped; {} holes ({} samples lost): {} bridged ({} samples), {} left as gaps ({} samples; {} filled for their events); clock {:.4} Hz (nominal {:.4} Hz, {:+.1} ppm), first sample at {:.6} s, core at {:.3} Hz",
+            "summary: {} strides ({} valid, {} bridged, {} gap, {} estimated, {} without a length), {:.3} m ({:.3} m estimated); {} samples read, {} repeated dropped; {} holes ({} samples lost): {} bridged ({} samples), {} left as gaps ({} samples; {} filled for their events); clock {:.4} Hz (nominal {:.4} Hz, {:+.1} ppm), first sample at {:.6} s, core at {:.3} Hz",
             self.strides,
             self.valid_strides,
             self.bridged_strides,
             self.gap_strides,
-            self.distance_m,
+            self.estimated_strides,
+            self.unestimated_strides,
+            // `+ 0.0`: an empty sum is −0.0.
+            self.distance_m + 0.0,
+            self.estimated_distance_m + 0.0,
             self.samples_read,
             self.repeated_dropped,
             self.holes,
@@ -125,6 +151,26 @@ impl Summary {
             },
             self.core_rate_hz,
         );
+        let clipped: Vec<String> = self
+            .rails
+            .iter()
+            .filter(|a| a.clipped > 0)
+            .map(|a| format!("{} {}", a.axis, a.clipped))
+            .collect();
+        s += &format!(
+            "; clipped samples: {}",
+            if clipped.is_empty() {
+                "none".to_string()
+            } else {
+                clipped.join(", ")
+            }
+        );
+        if self.core_rate_hz > 0.0 && self.core_rate_hz < LOW_RATE_HZ {
+            s += &format!(
+                "; warning: {:.1} Hz is below {LOW_RATE_HZ} Hz, where gait events are coarse and lengths untested",
+                self.core_rate_hz
+            );
+        }
         if self.retimed_stamps > 0 {
             s += &format!(
                 "; re-timed: {} stamps off the clock by more than a quarter period (at most {:.2} ms)",
@@ -134,6 +180,9 @@ impl Summary {
         s
     }
 }
+
+/// Below this rate a replay warns: the datasets that check the core run at 100–800 Hz.
+pub const LOW_RATE_HZ: f64 = 100.0;
 
 /// A stride as the host reports it.
 #[derive(Clone, Debug, PartialEq, Serialize)]
@@ -188,7 +237,8 @@ pub struct StrideReport {
     pub turning_angle_deg: f64,
     /// `walking`, `running` (stance under half the cycle) or `unknown` (not one cycle).
     pub gait: &'static str,
-    /// False when the length is not to be trusted (see `flags`).
+    /// False when the length was not measured or is not to be trusted (see `flags`; an
+    /// `estimated` one still counts in the distance).
     pub valid: bool,
     /// Names of the flags set.
     pub flags: Vec<&'static str>,
@@ -232,6 +282,12 @@ pub fn flag_names(f: StrideFlags) -> Vec<&'static str> {
     }
     if f.has(StrideFlags::GYRO_CLIPPED) {
         v.push("gyro_clipped");
+    }
+    if f.has(StrideFlags::ACCEL_CLIPPED) {
+        v.push("accel_clipped");
+    }
+    if f.has(StrideFlags::ESTIMATED) {
+        v.push("estimated");
     }
     v
 }
@@ -302,6 +358,8 @@ pub struct Prepared {
     pub clock: SampleClock,
     /// The rate the core runs at.
     pub rate: SampleRate,
+    /// Where each axis clipped ([`crate::rails`]), and how often.
+    pub rails: RailsReport,
     /// Rows read and re-sent samples dropped.
     read: (usize, usize),
     nominal_hz: f64,
@@ -341,11 +399,25 @@ impl Prepared {
                 .iter()
                 .filter(|s| s.0.flags.has(StrideFlags::GAP))
                 .count(),
+            estimated_strides: strides
+                .iter()
+                .filter(|s| s.0.flags.has(StrideFlags::ESTIMATED))
+                .count(),
+            unestimated_strides: strides
+                .iter()
+                .filter(|s| !s.0.flags.counts_distance())
+                .count(),
             distance_m: strides
                 .iter()
-                .filter(|s| s.0.flags.valid())
+                .filter(|s| s.0.flags.counts_distance())
                 .map(|s| s.0.length_mm as f64 / 1000.0)
                 .sum(),
+            estimated_distance_m: strides
+                .iter()
+                .filter(|s| s.0.flags.has(StrideFlags::ESTIMATED))
+                .map(|s| s.0.length_mm as f64 / 1000.0)
+                .sum(),
+            rails: self.rails.axes.clone(),
             nominal_rate_hz: self.nominal_hz,
             clock_rate_hz: self.clock.rate_hz(),
             clock_offset_s: self.clock.offset_s,
@@ -356,9 +428,12 @@ impl Prepared {
         (strides, summary)
     }
 
-    /// The default configuration at the core's rate and `ranges`.
+    /// The default configuration at the core's rate and `ranges`, with the recording's
+    /// rails.
     pub fn config(&self, ranges: Ranges) -> Config {
-        Config::new(self.rate, ranges.accel.scale(), ranges.gyro.scale())
+        let mut c = Config::new(self.rate, ranges.accel.scale(), ranges.gyro.scale());
+        c.rails = self.rails.rails;
+        c
     }
 }
 
@@ -372,12 +447,14 @@ pub fn prepare(trace: &Trace, ranges: Ranges) -> Result<Prepared, ReplayError> {
     let rate = SampleRate::from_millihertz(mhz.clamp(0.0, u32::MAX as f64) as u32)
         .ok_or(ReplayError::Rate(clock.rate_hz()))?;
     let counts: Vec<RawSample> = samples.iter().map(|s| ranges.to_counts(s)).collect();
+    let rails = rails::learn(&samples, ranges, trace.given);
     // Holes inside a host's bursts, placed by the angular rate.
     clock.place_holes(&stamps, |row| counts[row].gyro.map(|v| v as f64));
     Ok(Prepared {
         counts,
         clock,
         rate,
+        rails,
         read: (
             trace.samples.len() + trace.repeated,
             trace.repeated + repeated,

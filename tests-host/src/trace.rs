@@ -28,6 +28,9 @@ pub struct Trace {
     /// Samples dropped by the reader as re-sent: a stamp equal to the one before, or
     /// earlier by less than half a period ([`crate::clock::drop_repeats`]).
     pub repeated: usize,
+    /// The sensor's nominal ranges, where known (`--acc-range-g`, `--gyro-range-dps`,
+    /// `meta.json`): the rails where no flat run shows others ([`crate::rails`]).
+    pub given: crate::rails::GivenRanges,
 }
 
 /// Sensor ranges used to turn physical units into counts.

@@ -52,6 +52,15 @@ enum Cmd {
         /// Also write the samples and the strides to this MCAP file (opens in Foxglove).
         #[arg(long, value_name = "FILE")]
         mcap_out: Option<PathBuf>,
+        /// The accelerometer's nominal full scale, g (default: `acc_range_g` of a meta.json
+        /// beside the file, else ±16 g). Each axis's rail is learnt from flat runs at its
+        /// extremes; without one, this is its rail.
+        #[arg(long, value_name = "G")]
+        acc_range_g: Option<f64>,
+        /// The gyroscope's nominal full scale, °/s (default: `gyro_range_dps` of a meta.json,
+        /// else ±2000 °/s); rails learnt as for the accelerometer.
+        #[arg(long, value_name = "DPS")]
+        gyro_range_dps: Option<f64>,
     },
     /// Score stride detection, gait events, phases and stance against the ground truth of
     /// dataset folders (`../shared/datasets/<name>`); prints Markdown tables.
@@ -148,6 +157,44 @@ enum Cmd {
         /// The folder holding the datasets (`../shared/datasets`).
         #[arg(default_value = "../../shared/datasets")]
         datasets: PathBuf,
+    },
+    /// Clip `gaitmap_walk` and `pyshoe_vicon` at ±8 g, ±4 g and ±12 g and compare each clipped
+    /// stride with its unclipped self, with the loss left in and put back.
+    Clipping {
+        /// The folder holding the datasets (`../shared/datasets`).
+        #[arg(default_value = "../../shared/datasets")]
+        datasets: PathBuf,
+    },
+    /// Replay the datasets at their own rate and decimated to lower rates, and compare the
+    /// strides.
+    Rates {
+        /// The folder holding the datasets (`../shared/datasets`).
+        #[arg(default_value = "../../shared/datasets")]
+        datasets: PathBuf,
+    },
+    /// The stance instant by pace against the Vicon foot marker of `pyshoe_vicon`: how
+    /// still the foot is there, what the rolling contact imposes, the duty factor.
+    Running {
+        /// The folder holding the datasets (`../shared/datasets`).
+        #[arg(default_value = "../../shared/datasets")]
+        datasets: PathBuf,
+    },
+    /// What each stride flag costs: the flags as they occur on the datasets against their
+    /// references, and made on purpose (holes, clipping) against the strides undegraded.
+    Flags {
+        /// The folder holding the datasets (`../shared/datasets`).
+        #[arg(default_value = "../../shared/datasets")]
+        datasets: PathBuf,
+    },
+    /// Regenerate the measured tables of `docs/` (the blocks marked `<!-- generated: gaitclip
+    /// NAME -->`) from the datasets; `--check` writes nothing and fails on a stale block.
+    Docs {
+        /// The folder holding the datasets (`../shared/datasets`).
+        #[arg(default_value = "../../shared/datasets")]
+        datasets: PathBuf,
+        /// Only check that every block is current.
+        #[arg(long)]
+        check: bool,
     },
     /// Regenerate the simulated fixtures (traces with ground truth) into a folder.
     Simulate {
@@ -300,6 +347,8 @@ fn run(cli: Cli) -> anyhow::Result<()> {
             model,
             all_models,
             mcap_out,
+            acc_range_g,
+            gyro_range_dps,
         } => {
             let detector = Detector::from_name(&detector).context("unknown detector")?;
             let model = match model.as_deref() {
@@ -315,7 +364,21 @@ fn run(cli: Cli) -> anyhow::Result<()> {
                 )
                 .into());
             }
-            let t = read_trace(&trace, rate)?;
+            let mut t = read_trace(&trace, rate)?;
+            for (given, name) in [
+                (acc_range_g, "--acc-range-g"),
+                (gyro_range_dps, "--gyro-range-dps"),
+            ] {
+                if given.is_some_and(|v| !(v.is_finite() && v > 0.0)) {
+                    return Err(UsageError(match name {
+                        "--acc-range-g" => "--acc-range-g must be a positive number of g",
+                        _ => "--gyro-range-dps must be a positive number of °/s",
+                    })
+                    .into());
+                }
+            }
+            t.given.acc_g = acc_range_g.or(t.given.acc_g);
+            t.given.gyro_dps = gyro_range_dps.or(t.given.gyro_dps);
             let (strides, summary) =
                 replay::replay_summarised(&t, Ranges::default(), detector, model, all_models)
                     .with_context(|| trace.display().to_string())?;
@@ -349,6 +412,14 @@ fn run(cli: Cli) -> anyhow::Result<()> {
                 );
             } else {
                 println!("{}", summary.line());
+            }
+            if summary.core_rate_hz < replay::LOW_RATE_HZ {
+                eprintln!(
+                    "gaitclip: warning: {} is at {:.1} Hz, below {} Hz: gait events are coarse and lengths are not checked at this rate",
+                    trace.display(),
+                    summary.core_rate_hz,
+                    replay::LOW_RATE_HZ
+                );
             }
             if let Some(out) = mcap_out {
                 let f = std::fs::File::create(&out).map_err(|source| WriteError {
@@ -515,6 +586,40 @@ fn run(cli: Cli) -> anyhow::Result<()> {
         }
         Cmd::ZuptSweep { datasets } => {
             print!("{}", gaitclip_host::zupt_sweep::report(&datasets)?);
+        }
+        Cmd::Clipping { datasets } => {
+            print!("{}", gaitclip_host::clip_sweep::report(&datasets)?);
+        }
+        Cmd::Rates { datasets } => {
+            print!("{}", gaitclip_host::rate_sweep::report(&datasets)?);
+        }
+        Cmd::Running { datasets } => {
+            print!("{}", gaitclip_host::running::report(&datasets)?);
+        }
+        Cmd::Flags { datasets } => {
+            print!("{}", gaitclip_host::flag_costs::report(&datasets)?);
+        }
+        Cmd::Docs { datasets, check } => {
+            let pages =
+                gaitclip_host::docs::regenerate(&gaitclip_host::docs::docs_dir(), &datasets)?;
+            let mut stale = Vec::new();
+            for p in &pages {
+                if p.stale.is_empty() {
+                    continue;
+                }
+                stale.push(format!("{}: {}", p.path.display(), p.stale.join(", ")));
+                if !check {
+                    std::fs::write(&p.path, &p.text).map_err(|source| WriteError {
+                        path: p.path.clone(),
+                        source,
+                    })?;
+                }
+            }
+            match (check, stale.is_empty()) {
+                (_, true) => eprintln!("docs: every generated block is current"),
+                (false, false) => eprintln!("docs: rewrote {}", stale.join("; ")),
+                (true, false) => anyhow::bail!("docs: stale blocks: {}", stale.join("; ")),
+            }
         }
         Cmd::Simulate { out } => {
             fixtures::write_all(&out)?;

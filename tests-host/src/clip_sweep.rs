@@ -1,0 +1,284 @@
+//! `gaitclip clipping`: what a clipped accelerometer costs a stride, and what putting its loss
+//! back ([`gaitclip::clipping`]) recovers, measured on real recordings clipped on purpose.
+//!
+//! `gaitmap_walk` and `pyshoe_vicon` are replayed as recorded (±16 g: their sensors barely
+//! reach it) and again clipped: converted at the MPU6050's ±8 g and ±4 g ranges (the counts
+//! saturate), and as a part given as ±8 g that clips at 7 g: clamped there in physical units
+//! but converted at ±16 g, so that the rails sit inside the counts and must be learnt from the
+//! data ([`crate::rails`]). Each
+//! stride of a clipped replay that starts and ends at the same stance instants as a stride of
+//! the unclipped replay (clipping moved the others' instants: counted apart; what a moved
+//! instant takes from one stride it gives the next) has its ZUPT length compared with that
+//! stride's: with the
+//! loss left in (`Config::restore_accel` false) and put back, and against what the estimate
+//! from the strides before it ([`gaitclip::estimate`]) would have said: on every row putting
+//! the loss back is far nearer, so a clipped stride is always measured, never estimated. By
+//! how many samples clipped and where in the
+//! stride (push-off: heel-off to toe-off; swing; heel strike: heel-strike to the stance
+//! instant that ends the stride).
+
+use anyhow::Result;
+use gaitclip::sample::{AccelRange, GyroRange, Rails, RawSample};
+use gaitclip::stride::{Stride, StrideFlags};
+
+use crate::datasets;
+use crate::markdown::{cm_cell, Table};
+use crate::trace::{Ranges, Trace, G_MPS2};
+use crate::{csv_trace, replay};
+
+/// One way of clipping a recording.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Clipping {
+    /// Row label.
+    pub label: &'static str,
+    /// The ranges the recording is converted at (their counts saturate).
+    pub ranges: Ranges,
+    /// A clamp in physical units before the conversion, g, of a part given as ±8 g (its
+    /// rails then learnt).
+    pub clamp_g: Option<f64>,
+}
+
+/// The clippings of the tables (the last: a part given as ±8 g, clipping below it at 7 g, its
+/// rails inside the ±16 g counts, so that they must be learnt).
+pub const CLIPPINGS: [Clipping; 3] = [
+    Clipping {
+        label: "±8 g (MPU6050 range)",
+        ranges: Ranges {
+            accel: AccelRange::G8,
+            gyro: GyroRange::Dps2000,
+        },
+        clamp_g: None,
+    },
+    Clipping {
+        label: "±4 g (MPU6050 range)",
+        ranges: Ranges {
+            accel: AccelRange::G4,
+            gyro: GyroRange::Dps2000,
+        },
+        clamp_g: None,
+    },
+    Clipping {
+        label: "a ±8 g part clipping at 7 g (rails learnt)",
+        ranges: Ranges {
+            accel: AccelRange::G16,
+            gyro: GyroRange::Dps2000,
+        },
+        clamp_g: Some(7.0),
+    },
+];
+
+/// Where in its stride a clipped sample lies.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Position {
+    /// Before heel-off (the stance the stride starts in).
+    Stance,
+    /// Heel-off to toe-off.
+    PushOff,
+    /// Toe-off to heel-strike.
+    Swing,
+    /// Heel-strike to the end.
+    HeelStrike,
+}
+
+/// One clipped stride against its unclipped self.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct ClippedStride {
+    /// Samples of the stride with an accelerometer axis at a rail.
+    pub clipped_samples: u32,
+    /// Where most of them lie.
+    pub position: Position,
+    /// ZUPT length with the loss left in, minus the unclipped stride's, m.
+    pub left_m: f64,
+    /// ZUPT length with the loss put back, minus the unclipped stride's, m.
+    pub restored_m: f64,
+    /// What the estimate from the strides before it would have said, minus the unclipped
+    /// stride's reported length, m.
+    pub estimate_m: Option<f64>,
+}
+
+/// The clipped strides of one dataset under one clipping, and how many strides there were.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct SweepResult {
+    /// Strides of the clipped replay with the instants of an unclipped one.
+    pub matched: usize,
+    /// Clipped strides whose instants clipping moved.
+    pub moved: usize,
+    /// Clipped samples in the recordings.
+    pub clipped_samples: usize,
+    /// The clipped strides.
+    pub strides: Vec<ClippedStride>,
+}
+
+fn clamp_trace(t: &Trace, g: f64) -> Trace {
+    let lim = g * G_MPS2;
+    let mut out = t.clone();
+    out.given.acc_g = Some(8.0);
+    for s in &mut out.samples {
+        for a in &mut s.acc_mps2 {
+            *a = a.clamp(-lim, lim);
+        }
+    }
+    out
+}
+
+/// The unclipped stride between the same two instants as `s`.
+fn same_instants<'a>(s: &Stride, refs: &'a [Stride]) -> Option<&'a Stride> {
+    refs.iter().find(|r| r.start == s.start && r.end == s.end)
+}
+
+fn position(s: &Stride, at: &[u32]) -> Position {
+    let mut n = [0usize; 4];
+    for &i in at {
+        let p = if i < s.heel_off {
+            0
+        } else if i < s.toe_off {
+            1
+        } else if i < s.heel_strike {
+            2
+        } else {
+            3
+        };
+        n[p] += 1;
+    }
+    let k = (0..4).max_by_key(|&k| n[k]).unwrap_or(3);
+    [
+        Position::Stance,
+        Position::PushOff,
+        Position::Swing,
+        Position::HeelStrike,
+    ][k]
+}
+
+/// One dataset under one clipping.
+pub fn sweep(dataset: &datasets::Dataset, clipping: &Clipping) -> Result<SweepResult> {
+    let mut out = SweepResult::default();
+    for trial in &dataset.trials {
+        let t = csv_trace::read(&trial.csv, Some(dataset.rate_hz))?;
+        let unclipped = replay::prepare(&t, Ranges::default())?;
+        let refs = unclipped.strides(unclipped.config(Ranges::default()));
+        let ct = match clipping.clamp_g {
+            Some(g) => clamp_trace(&t, g),
+            None => t.clone(),
+        };
+        let p = replay::prepare(&ct, clipping.ranges)?;
+        let config = p.config(clipping.ranges);
+        let restored = p.strides(config);
+        let left = p.strides(gaitclip::pipeline::Config {
+            restore_accel: false,
+            ..config
+        });
+        let rails: Rails = config.rails;
+        let clipped_at: Vec<u32> = p
+            .counts
+            .iter()
+            .enumerate()
+            .filter(|(_, s)| rails.accel_clipped(s))
+            .map(|(i, _)| p.clock.number_of_row(i))
+            .collect();
+        out.clipped_samples += clipped_at.len();
+        let mut estimator = gaitclip::estimate::LengthEstimator::new();
+        for (s, l) in restored.iter().zip(&left) {
+            let est = estimator.estimate_mm();
+            estimator.process(&mut s.clone());
+            if !s.flags.has(StrideFlags::ACCEL_CLIPPED) || s.flags.has(StrideFlags::GAP) {
+                out.matched += 1;
+                continue;
+            }
+            let Some(r) = same_instants(s, &refs) else {
+                out.moved += 1;
+                continue;
+            };
+            out.matched += 1;
+            let at: Vec<u32> = clipped_at
+                .iter()
+                .copied()
+                .filter(|&i| i > s.start && i <= s.end)
+                .collect();
+            let m = |x: &Stride| x.zupt_um as f64 / 1e6;
+            out.strides.push(ClippedStride {
+                clipped_samples: at.len() as u32,
+                position: position(s, &at),
+                left_m: m(l) - m(r),
+                restored_m: m(s) - m(r),
+                estimate_m: est.map(|e| (e as f64 - r.length_mm as f64) / 1000.0),
+            });
+        }
+    }
+    Ok(out)
+}
+
+/// The clipped samples of `counts` at `rails`, for tests.
+pub fn clipped_samples(counts: &[RawSample], rails: &Rails) -> usize {
+    counts.iter().filter(|s| rails.accel_clipped(s)).count()
+}
+
+/// The two tables, Markdown, for the datasets under `root`.
+pub fn report(root: &std::path::Path) -> Result<String> {
+    let sets: Vec<datasets::Dataset> = ["gaitmap_walk", "pyshoe_vicon"]
+        .iter()
+        .map(|n| datasets::load(&root.join(n)))
+        .collect::<Result<_>>()?;
+    let mut summary = Table::new([
+        "clipping",
+        "dataset",
+        "clipped samples",
+        "clipped strides (of strides)",
+        "instants moved",
+        "loss left in",
+        "loss put back",
+        "estimate instead",
+    ]);
+    let mut by = Table::new([
+        "clipping",
+        "dataset",
+        "1 sample",
+        "2–3",
+        "4–9",
+        "≥ 10",
+        "at push-off",
+        "in the swing",
+        "at heel strike",
+    ]);
+    for c in &CLIPPINGS {
+        for d in &sets {
+            let r = sweep(d, c)?;
+            let pick = |f: &dyn Fn(&ClippedStride) -> Option<f64>| -> Vec<f64> {
+                r.strides.iter().filter_map(f).collect()
+            };
+            summary.row([
+                c.label.to_string(),
+                d.name.clone(),
+                r.clipped_samples.to_string(),
+                format!("{} ({})", r.strides.len(), r.matched + r.moved),
+                r.moved.to_string(),
+                cm_cell(&pick(&|s| Some(s.left_m))),
+                cm_cell(&pick(&|s| Some(s.restored_m))),
+                cm_cell(&pick(&|s| s.estimate_m)),
+            ]);
+            let n = |lo: u32, hi: u32| {
+                cm_cell(&pick(&|s| {
+                    (s.clipped_samples >= lo && s.clipped_samples <= hi).then_some(s.restored_m)
+                }))
+            };
+            let at = |p: Position| cm_cell(&pick(&|s| (s.position == p).then_some(s.restored_m)));
+
+            by.row([
+                c.label.to_string(),
+                d.name.clone(),
+                n(1, 1),
+                n(2, 3),
+                n(4, 9),
+                n(10, u32::MAX),
+                at(Position::PushOff),
+                at(Position::Swing),
+                at(Position::HeelStrike),
+            ]);
+        }
+    }
+    Ok(format!(
+        "Clipped strides against their unclipped selves (ZUPT length; RMSE / bias cm (strides)):\n\n{}\n\
+         The loss put back, by clipped samples in the stride and where most of them lie (RMSE / bias cm (strides)):\n\n{}",
+        summary.render(),
+        by.render()
+    ))
+}

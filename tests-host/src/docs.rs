@@ -1,0 +1,150 @@
+//! `gaitclip docs`: the measured tables of `docs/`, written by the tools that measure them.
+//!
+//! A page marks each generated block:
+//!
+//! ```text
+//! <!-- generated: gaitclip clipping -->
+//! …whatever the command prints…
+//! <!-- end generated -->
+//! ```
+//!
+//! `gaitclip docs` runs every marked command on `../shared/datasets` and writes its output
+//! between the markers; `gaitclip docs --check` writes nothing and fails naming every block
+//! whose text differs, which `tests/docs_current.rs` runs in the test command. Re-measuring
+//! is a command, not an edit. Only deterministic measurements are generated (counts, errors,
+//! instruction counts), never a time.
+
+use std::path::{Path, PathBuf};
+
+use anyhow::{bail, Context, Result};
+
+/// What prints one block, from the datasets folder.
+pub type Generator = fn(&Path) -> Result<String>;
+
+/// The commands a page may mark, and what prints their block.
+pub const GENERATORS: &[(&str, Generator)] = &[
+    ("clipping", crate::clip_sweep::report),
+    ("rates", crate::rate_sweep::report),
+    ("running", crate::running::report),
+    ("flags", crate::flag_costs::report),
+];
+
+const OPEN: &str = "<!-- generated: gaitclip ";
+const CLOSE: &str = "<!-- end generated -->";
+
+/// One page whose generated blocks were (or would be) rewritten.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct Page {
+    /// The page.
+    pub path: PathBuf,
+    /// Its text with every block regenerated.
+    pub text: String,
+    /// The blocks whose text changed.
+    pub stale: Vec<String>,
+}
+
+/// `text` with every generated block replaced by its command's output, and the names of the
+/// blocks that changed. `run` prints a named block.
+pub fn regenerate_text(
+    text: &str,
+    mut run: impl FnMut(&str) -> Result<String>,
+) -> Result<(String, Vec<String>)> {
+    let mut out = String::with_capacity(text.len());
+    let mut stale = Vec::new();
+    let mut rest = text;
+    while let Some(at) = rest.find(OPEN) {
+        let (before, from) = rest.split_at(at);
+        out.push_str(before);
+        let line_end = from
+            .find('\n')
+            .context("a generated block's marker ends the file")?;
+        let marker = &from[..line_end];
+        let name = marker
+            .strip_prefix(OPEN)
+            .and_then(|m| m.strip_suffix("-->"))
+            .map(str::trim)
+            .with_context(|| format!("malformed marker `{marker}`"))?;
+        let body_start = line_end + 1;
+        let Some(close) = from[body_start..].find(CLOSE) else {
+            bail!("block `{name}` has no `{CLOSE}`");
+        };
+        let old = &from[body_start..body_start + close];
+        let mut new = run(name).with_context(|| format!("gaitclip {name}"))?;
+        if !new.ends_with('\n') {
+            new.push('\n');
+        }
+        if old != new {
+            stale.push(name.to_string());
+        }
+        out.push_str(marker);
+        out.push('\n');
+        out.push_str(&new);
+        out.push_str(CLOSE);
+        rest = &from[body_start + close + CLOSE.len()..];
+    }
+    out.push_str(rest);
+    Ok((out, stale))
+}
+
+/// Every page of `docs` (`*.md`) regenerated from the datasets under `datasets`.
+pub fn regenerate(docs: &Path, datasets: &Path) -> Result<Vec<Page>> {
+    let mut paths: Vec<PathBuf> = std::fs::read_dir(docs)
+        .with_context(|| format!("{}", docs.display()))?
+        .filter_map(|e| e.ok().map(|e| e.path()))
+        .filter(|p| p.extension().is_some_and(|e| e == "md"))
+        .collect();
+    paths.sort();
+    let mut cache: Vec<(String, String)> = Vec::new();
+    let mut pages = Vec::new();
+    for path in paths {
+        let text = std::fs::read_to_string(&path).with_context(|| format!("{}", path.display()))?;
+        let (text, stale) = regenerate_text(&text, |name| {
+            if let Some((_, out)) = cache.iter().find(|(n, _)| n == name) {
+                return Ok(out.clone());
+            }
+            let Some((_, f)) = GENERATORS.iter().find(|(n, _)| *n == name) else {
+                bail!("no generator `{name}` (known: {:?})", names());
+            };
+            let out = f(datasets)?;
+            cache.push((name.to_string(), out.clone()));
+            Ok(out)
+        })?;
+        pages.push(Page { path, text, stale });
+    }
+    Ok(pages)
+}
+
+/// The generator names.
+pub fn names() -> Vec<&'static str> {
+    GENERATORS.iter().map(|(n, _)| *n).collect()
+}
+
+/// The repository's `docs/` folder.
+pub fn docs_dir() -> PathBuf {
+    PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../docs")
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_block_is_replaced_and_reported_stale_only_when_it_differs() {
+        let page = "# t\n<!-- generated: gaitclip x -->\nold\n<!-- end generated -->\ntail\n";
+        let (text, stale) = regenerate_text(page, |_| Ok("new".into())).unwrap();
+        assert_eq!(
+            text,
+            "# t\n<!-- generated: gaitclip x -->\nnew\n<!-- end generated -->\ntail\n"
+        );
+        assert_eq!(stale, vec!["x".to_string()]);
+        let (again, stale) = regenerate_text(&text, |_| Ok("new\n".into())).unwrap();
+        assert_eq!(again, text);
+        assert!(stale.is_empty());
+        assert!(
+            regenerate_text("<!-- generated: gaitclip x -->\nno end", |_| Ok(
+                String::new()
+            ))
+            .is_err()
+        );
+    }
+}

@@ -1,0 +1,240 @@
+//! Where a recording's sensor clipped, axis by axis: learnt from the data, or given.
+//!
+//! Real parts clip below their nominal range (a ±16 g accelerometer axis at −15.6 g, a
+//! ±2000 °/s gyro at ±1 988 °/s), and a replay that assumed the nominal rails would neither
+//! flag nor restore those samples. A rail shows in the data as a **flat run at an
+//! extreme**: the samples within [`FLAT_TOLERANCE`] of the axis's most extreme value, seen
+//! more than once (a clipped heel strike every stride) or for [`MIN_RUN`] samples in a row. A
+//! smooth peak, however fast the sampling, has one sample at its top, and different peaks
+//! reach different heights; a rail makes different events stop at the same level.
+//!
+//! Without such a plateau the axis's rail is its nominal range: given (`--acc-range-g`,
+//! `--gyro-range-dps`, or `acc_range_g` / `gyro_range_dps` in a `meta.json`), or else the
+//! MPU6050 range the replay converts to (±16 g, ±2000 °/s), whose counts saturate there.
+//! The learnt or nominal rail goes to the core in counts ([`gaitclip::sample::Rails`]).
+
+use gaitclip::sample::{AxisRails, Rails};
+use serde::Serialize;
+
+use crate::trace::{ImuSample, Ranges, G_MPS2};
+
+/// A sample within this share of an axis's extreme value sits on the plateau (a real part's
+/// rail wanders by ±0.3 % with the other axes' cross-coupling: `esangeni_run`).
+pub const FLAT_TOLERANCE: f64 = 0.005;
+/// A flat run at the extreme of at least this many samples is a rail.
+pub const MIN_RUN: usize = 3;
+/// Or: this many separate flat runs of at least two samples, or this many samples exactly at
+/// the extreme (a digital rail repeats its value; a smooth peak's top is one sample, and two
+/// peaks within 0.5 % of each other happen by chance: `pyshoe_vicon` at 7.97 g).
+pub const MIN_EVENTS: usize = 2;
+/// An extreme below this share of the nominal range is no rail, however flat (a stance
+/// reading nothing but gravity).
+pub const MIN_SHARE_OF_RANGE: f64 = 0.5;
+
+/// The nominal ranges a recording's sensor was set to, where known.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize)]
+pub struct GivenRanges {
+    /// Accelerometer full scale, g.
+    pub acc_g: Option<f64>,
+    /// Gyroscope full scale, °/s.
+    pub gyro_dps: Option<f64>,
+}
+
+/// How one side of one axis's rail was found.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum RailSource {
+    /// A flat run at the extreme.
+    Learnt,
+    /// The nominal range (given, or the conversion's).
+    Nominal,
+}
+
+/// One side of one axis.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize)]
+pub struct Rail {
+    /// The rail, in the axis's unit (m/s² or rad/s), signed.
+    pub value: f64,
+    /// How it was found.
+    pub source: RailSource,
+}
+
+/// Both rails of one axis, and how many samples sat at them.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize)]
+pub struct AxisReport {
+    /// `acc_x` … `gyr_z`.
+    pub axis: &'static str,
+    /// The negative rail.
+    pub low: Rail,
+    /// The positive rail.
+    pub high: Rail,
+    /// Samples at either rail (counted in the counts fed to the core).
+    pub clipped: usize,
+}
+
+/// The rails of a recording, axis by axis, and the core's rails in counts.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct RailsReport {
+    /// Accelerometer x, y, z, then gyroscope x, y, z.
+    pub axes: Vec<AxisReport>,
+    /// What the core is told.
+    #[serde(skip)]
+    pub rails: Rails,
+}
+
+/// Axis names, in [`RailsReport::axes`] order.
+pub const AXES: [&str; 6] = ["acc_x", "acc_y", "acc_z", "gyr_x", "gyr_y", "gyr_z"];
+
+impl RailsReport {
+    /// Axes that clipped, as `name n` items, or `none`.
+    pub fn clipped_line(&self) -> String {
+        let c: Vec<String> = self
+            .axes
+            .iter()
+            .filter(|a| a.clipped > 0)
+            .map(|a| {
+                let (unit, scale) = if a.axis.starts_with("acc") {
+                    ("g", 1.0 / G_MPS2)
+                } else {
+                    ("°/s", 180.0 / std::f64::consts::PI)
+                };
+                let side = |r: &Rail| {
+                    format!(
+                        "{:+.2} {unit}{}",
+                        r.value * scale,
+                        if r.source == RailSource::Learnt {
+                            " learnt"
+                        } else {
+                            ""
+                        }
+                    )
+                };
+                format!(
+                    "{} {} at {} / {}",
+                    a.axis,
+                    a.clipped,
+                    side(&a.low),
+                    side(&a.high)
+                )
+            })
+            .collect();
+        if c.is_empty() {
+            "none".into()
+        } else {
+            c.join(", ")
+        }
+    }
+
+    /// Samples with any axis at a rail.
+    pub fn clipped_total(&self) -> usize {
+        self.axes.iter().map(|a| a.clipped).sum()
+    }
+}
+
+/// The value of channel `k` (0–2 accelerometer, 3–5 gyroscope) of a sample.
+fn channel(s: &ImuSample, k: usize) -> f64 {
+    if k < 3 {
+        s.acc_mps2[k]
+    } else {
+        s.gyr_radps[k - 3]
+    }
+}
+
+/// The rail on one side (`sign` ±1) of channel `k`, from a flat run at the extreme, if the
+/// data shows one above [`MIN_SHARE_OF_RANGE`] of `nominal` (> 0, the axis's unit).
+fn plateau(samples: &[ImuSample], k: usize, sign: f64, nominal: f64) -> Option<f64> {
+    let m = samples
+        .iter()
+        .map(|s| sign * channel(s, k))
+        .filter(|v| v.is_finite())
+        .fold(f64::NEG_INFINITY, f64::max);
+    // `m` is −∞ for no finite sample: no rail either.
+    if m.is_nan() || m < MIN_SHARE_OF_RANGE * nominal {
+        return None;
+    }
+    let edge = m - FLAT_TOLERANCE * m;
+    let (mut flat_runs, mut longest, mut run, mut exact) = (0usize, 0usize, 0usize, 0usize);
+    for s in samples {
+        let v = sign * channel(s, k);
+        if v >= m {
+            exact += 1;
+        }
+        if v >= edge {
+            run += 1;
+            if run == 2 {
+                flat_runs += 1;
+            }
+            longest = longest.max(run);
+        } else {
+            run = 0;
+        }
+    }
+    (longest >= MIN_RUN || flat_runs >= MIN_EVENTS || exact >= MIN_EVENTS).then_some(edge)
+}
+
+/// The rails of `samples`, converted at `ranges` (the core's counts), with the nominal
+/// ranges `given` where known.
+pub fn learn(samples: &[ImuSample], ranges: Ranges, given: GivenRanges) -> RailsReport {
+    // The conversion's own full scale: its counts saturate there.
+    let acc_full = 32768.0 / ranges.accel_counts_per_mps2();
+    let gyr_full = 32768.0 / ranges.gyro_counts_per_radps();
+    let acc_nominal = given.acc_g.map_or(acc_full, |g| (g * G_MPS2).min(acc_full));
+    let gyr_nominal = given
+        .gyro_dps
+        .map_or(gyr_full, |d| d.to_radians().min(gyr_full));
+    let mut axes = Vec::with_capacity(6);
+    let mut rails = Rails::FULL_SCALE;
+    for (k, &axis) in AXES.iter().enumerate() {
+        let (nominal, per_unit) = if k < 3 {
+            (acc_nominal, ranges.accel_counts_per_mps2())
+        } else {
+            (gyr_nominal, ranges.gyro_counts_per_radps())
+        };
+        let side = |sign: f64| match plateau(samples, k, sign, nominal) {
+            Some(v) => Rail {
+                value: sign * v.min(nominal),
+                source: if v < nominal {
+                    RailSource::Learnt
+                } else {
+                    RailSource::Nominal
+                },
+            },
+            None => Rail {
+                value: sign * nominal,
+                source: RailSource::Nominal,
+            },
+        };
+        let (low, high) = (side(-1.0), side(1.0));
+        // A sample at or beyond the rail in the unit reads at or beyond these counts.
+        let to_counts = |v: f64, round: fn(f64) -> f64| {
+            round(v * per_unit).clamp(i16::MIN as f64, i16::MAX as f64) as i16
+        };
+        let r = AxisRails::new(
+            to_counts(low.value, f64::ceil),
+            to_counts(high.value, f64::floor),
+        )
+        .unwrap_or(AxisRails::FULL_SCALE);
+        if k < 3 {
+            rails.accel[k] = r;
+        } else {
+            rails.gyro[k - 3] = r;
+        }
+        axes.push(AxisReport {
+            axis,
+            low,
+            high,
+            clipped: 0,
+        });
+    }
+    for s in samples {
+        let c = ranges.to_counts(s);
+        let bits = rails.clipped_axes(&c);
+        // Bits 0–2 accelerometer, 3–5 gyroscope: the same order as `AXES`.
+        for (k, a) in axes.iter_mut().enumerate() {
+            if bits & (1 << k) != 0 {
+                a.clipped += 1;
+            }
+        }
+    }
+    RailsReport { axes, rails }
+}
