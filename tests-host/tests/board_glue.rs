@@ -215,7 +215,16 @@ fn serial_stride_line_parses_back() {
         sleeps: u32::MAX,
         slept_periods: u32::MAX,
     };
-    serial_line::status(&mut status, u32::MAX, u32::MAX, u64::MAX, &c).unwrap();
+    serial_line::status(
+        &mut status,
+        u32::MAX,
+        u32::MAX,
+        u64::MAX,
+        u32::MAX,
+        &[u32::MAX; 6],
+        &c,
+    )
+    .unwrap();
     assert!(status.len() <= serial_line::MAX_LINE, "{}", status.len());
     assert!(status.starts_with("# status "));
 }

@@ -277,7 +277,8 @@ fn a_sensor_that_stops_mid_walk_is_restarted_and_its_stride_marked() {
     assert_eq!(gaps, vec![(stop, OUT as u32)]);
     assert_eq!(items.len() - 1, n - OUT);
     // The stride across the outage (25 ms: longer than the bridge limit, short enough to
-    // fill): reported once, a gap stride without a length, at its place.
+    // fill): reported once, a gap stride without a measured length, at its place, its
+    // length estimated from the two measured gait cycles before it.
     const {
         assert!(
             OUT as u32 * 5 > gaitclip::pipeline::BRIDGE_MAX_MS
@@ -290,9 +291,25 @@ fn a_sensor_that_stops_mid_walk_is_restarted_and_its_stride_marked() {
         .collect();
     assert_eq!(gap.len(), 1, "{strides:#?}");
     assert_eq!((gap[0].start, gap[0].end), (mid.start, mid.end));
+    let cycles: Vec<u32> = strides
+        .iter()
+        .take_while(|s| s.index < gap[0].index)
+        .filter(|s| {
+            s.flags.valid()
+                && !s
+                    .flags
+                    .has(StrideFlags::FROM_REST | StrideFlags::TO_REST | StrideFlags::GAP)
+        })
+        .map(|s| s.length_mm)
+        .collect();
+    let last_two = &cycles[cycles.len().saturating_sub(2)..];
+    assert_eq!(last_two.len(), 2, "{strides:#?}");
     assert!(
-        !gap[0].flags.valid() && gap[0].length_mm == 0,
-        "{:?}",
+        !gap[0].flags.valid()
+            && gap[0].flags.has(StrideFlags::ESTIMATED)
+            && gap[0].flags.counts_distance()
+            && gap[0].length_mm == (last_two[0] + last_two[1]).div_ceil(2),
+        "{:?} after {last_two:?}",
         gap[0]
     );
     // Before it, nothing changed; after it, every stride is found again at the same place.

@@ -152,3 +152,33 @@ fn a_bad_command_line_is_usage() {
     let (code, _) = gaitclip(&["replay", "--no-such-flag"]);
     assert_eq!(code, Some(2));
 }
+
+#[test]
+fn a_range_that_is_not_positive_is_a_usage_error() {
+    let p = tmp(
+        "range.csv",
+        format!("{HEADER}0,0,0,9.8,0,0,0\n0.005,0,0,9.8,0,0,0\n").as_bytes(),
+    );
+    for (flag, v) in [("--acc-range-g", "0"), ("--gyro-range-dps", "-5")] {
+        let arg = format!("{flag}={v}");
+        let (code, err) = gaitclip(&["replay", p.to_str().unwrap(), &arg]);
+        assert_eq!(code, Some(2), "{err}");
+        assert!(err.contains(flag), "{err}");
+    }
+    let _ = std::fs::remove_file(p);
+}
+
+#[test]
+fn a_replay_below_100_hz_warns_and_runs() {
+    let rows: String = (0..400)
+        .map(|i| format!("{},0,0,9.8,0,0,0\n", i as f64 / 60.0))
+        .collect();
+    let p = tmp("slow.csv", format!("{HEADER}{rows}").as_bytes());
+    let (code, err) = gaitclip(&["replay", p.to_str().unwrap()]);
+    assert_eq!(code, Some(0), "{err}");
+    assert!(
+        err.contains("warning") && err.contains("below 100 Hz"),
+        "{err}"
+    );
+    let _ = std::fs::remove_file(p);
+}

@@ -1,7 +1,8 @@
 //! The cycle detector's fixed-point strides against their `f64` twin
 //! ([`gaitclip_host::cycle_ref`]): every stride of every trial of the three datasets, at the
-//! MPU6050's widest ranges and at ±250 °/s (where nearly every stride clips and the tilt
-//! is put back on the clipped samples), within 1 mm of the twin.
+//! MPU6050's widest ranges, at ±250 °/s (where nearly every stride clips and the tilt
+//! is put back on the clipped samples) and at ±8 g and ±4 g (where the accelerometer's heel
+//! strikes and push-offs clip and their loss is put back), within 1 mm of the twin.
 
 use gaitclip::sample::{AccelRange, GyroRange};
 use gaitclip_host::cycle_ref::{self, Skipped};
@@ -19,15 +20,22 @@ fn cycle_strides_match_the_f64_twin_within_1_mm() {
         accel: AccelRange::G16,
         gyro: GyroRange::Dps250,
     };
+    let accel = |accel| Ranges {
+        accel,
+        gyro: GyroRange::Dps2000,
+    };
     for (name, ranges) in [
         ("gaitmap_walk", widest),
         ("pyshoe_vicon", widest),
         ("ipol_gait_events", widest),
         ("gaitmap_walk", clipping),
         ("pyshoe_vicon", clipping),
+        ("gaitmap_walk", accel(AccelRange::G8)),
+        ("pyshoe_vicon", accel(AccelRange::G4)),
     ] {
         let d = datasets::load(&root.join(name)).unwrap();
         let (mut measured, mut valid, mut worst, mut clipped) = (0usize, 0usize, 0f64, 0usize);
+        let mut accel_clipped = 0usize;
         let mut skipped = [0usize; 4];
         for trial in &d.trials {
             let t = csv_trace::read(&trial.csv, Some(d.rate_hz)).unwrap();
@@ -54,6 +62,9 @@ fn cycle_strides_match_the_f64_twin_within_1_mm() {
                         if s.flags.has(gaitclip::stride::StrideFlags::GYRO_CLIPPED) {
                             clipped += 1;
                         }
+                        if s.flags.has(gaitclip::stride::StrideFlags::ACCEL_CLIPPED) {
+                            accel_clipped += 1;
+                        }
                     }
                     Err(why) => {
                         skipped[match why {
@@ -67,9 +78,11 @@ fn cycle_strides_match_the_f64_twin_within_1_mm() {
             }
         }
         eprintln!(
-            "{name} at {:?}: {measured} of {valid} valid strides measured ({clipped} clipped), \
+            "{name} at {:?}/{:?}: {measured} of {valid} valid strides measured ({clipped} gyro \
+             clipped, {accel_clipped} accelerometer clipped), \
              worst {:.3} mm; skipped: flagged {}, first after a rest {}, missing {}, long rest {}",
             ranges.gyro,
+            ranges.accel,
             worst * 1e3,
             skipped[0],
             skipped[1],
@@ -83,6 +96,12 @@ fn cycle_strides_match_the_f64_twin_within_1_mm() {
         );
         if ranges.gyro == GyroRange::Dps250 {
             assert!(clipped * 2 >= measured, "{name}: {clipped} clipped strides");
+        }
+        if ranges.accel != AccelRange::G16 {
+            assert!(
+                accel_clipped * 4 >= measured,
+                "{name}: {accel_clipped} accelerometer-clipped strides"
+            );
         }
     }
 }

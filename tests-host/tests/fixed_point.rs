@@ -109,8 +109,9 @@ fn hamilton_product_within_2_lsb() {
 }
 
 /// Constant rotation at 5 rad/s about a random axis for one second at 200 Hz (0.025 rad a
-/// step): the integrated attitude stays within 5e−5 rad of the exact rotation and unit norm
-/// within 1e−8, as the doc comment of `integrate_half_angle` states per step.
+/// step), and at the ±2000 °/s rail at 100 Hz and 50 Hz: the integrated attitude stays
+/// within the per-step error the doc comment of `integrate_half_angle` states, times the
+/// steps, and unit norm within 1e−8.
 #[test]
 fn quaternion_integration_tracks_exact_rotation() {
     let mut r = rng();
@@ -118,7 +119,12 @@ fn quaternion_integration_tracks_exact_rotation() {
         let a: [f64; 3] = [0; 3].map(|_| r.random_range(-1.0..1.0));
         let n = a.iter().map(|v| v * v).sum::<f64>().sqrt();
         let axis = a.map(|v| v / n);
-        for (rate, hz, steps, bound) in [(5.0, 200.0, 200, 2e-6), (34.9, 100.0, 10, 5e-4)] {
+        // At the rail at 50 Hz a step turns 0.7 rad: θ⁵/120 = 1.4e−3 rad per step.
+        for (rate, hz, steps, bound) in [
+            (5.0, 200.0, 200, 2e-6),
+            (34.9, 100.0, 10, 5e-4),
+            (34.9, 50.0, 5, 8e-3),
+        ] {
             let h = axis.map(|v| q(v * rate / hz / 2.0));
             let mut att = QuatQ30::IDENTITY;
             for _ in 0..steps {
@@ -199,7 +205,8 @@ fn sample_rate_conversions() {
     let r = SampleRate::from_millihertz(204_800).unwrap();
     assert_eq!(r.samples_in_ms(50), 10); // 10.24
     assert_eq!(r.ms_of_samples(2048), 10_000);
-    assert!(SampleRate::from_hz(99).is_none() && SampleRate::from_hz(1001).is_none());
+    assert!(SampleRate::from_hz(49).is_none() && SampleRate::from_hz(1001).is_none());
+    assert!(SampleRate::from_hz(50).is_some());
     assert!(SampleRate::from_hz(u32::MAX).is_none());
 }
 
@@ -437,7 +444,9 @@ fn zupt_displacement_matches_f64_reference_within_1mm() {
         stance.iter().for_each(|s| sums.add(s));
         assert_eq!(sums.count as usize, stance.len());
         assert!(z.start(&sums));
-        movement.iter().for_each(|s| z.process(s));
+        movement
+            .iter()
+            .for_each(|s| z.process(s, &gaitclip::sample::Rails::FULL_SCALE));
         let d = z.displacement();
         let ZuptF64 {
             horizontal: h,
@@ -639,6 +648,7 @@ fn cycle_energy_matches_f64_within_its_bound() {
             rate,
             accel.scale(),
             gyro.scale(),
+            gaitclip::sample::Rails::FULL_SCALE,
             PhaseMethod::MajorPairs,
             80_000,
         );
@@ -722,7 +732,8 @@ fn rolling_contact_velocity_matches_f64() {
 /// one sample more than the peak spends above it).
 #[test]
 fn rail_run_reconstructs_a_clipped_peak() {
-    use gaitclip::zupt::RailRun;
+    use gaitclip::clipping::RailRun;
+    use gaitclip::sample::AxisRails;
     let mut ratios = Vec::new();
     for (peak, half_width) in [
         (40_000.0, 6.0),
@@ -739,10 +750,17 @@ fn rail_run_reconstructs_a_clipped_peak() {
             let mut run = RailRun::NEW;
             for t in 0..200 {
                 let x = (peak - a * (t as f64 - t0).powi(2)).max(0.0);
-                run.process(x.round().clamp(i16::MIN as f64, i16::MAX as f64) as i16);
+                run.process(
+                    x.round().clamp(i16::MIN as f64, i16::MAX as f64) as i16,
+                    AxisRails::FULL_SCALE,
+                );
             }
             let exact = 4.0 / 3.0 * (peak - rail) * half_width;
-            ratios.push((run.lost_counts_samples() as f64 / exact, half_width, offset));
+            ratios.push((
+                run.lost_counts_samples(AxisRails::FULL_SCALE) as f64 / exact,
+                half_width,
+                offset,
+            ));
         }
     }
     eprintln!("reconstructed / exact: {ratios:.3?}");

@@ -82,8 +82,12 @@ fn check<const M: usize>(
         assert!(s.end <= p.next_index(), "{s:?}");
         assert!(s.length_mm <= MAX_STRIDE_MM, "{s:?}");
         if s.flags.has(StrideFlags::GAP) {
-            assert_eq!(s.length_mm, 0, "no length across a gap: {s:?}");
+            // No length measured across a gap: the length is the estimate, or none.
             assert!(!s.flags.valid());
+            assert!(
+                s.flags.has(StrideFlags::ESTIMATED) || s.length_mm == 0,
+                "a gap stride's length is estimated or absent: {s:?}"
+            );
         }
         // The movement buffer holds M samples of heel-off to foot-flat; a longer movement is
         // flagged, not grown.
@@ -106,17 +110,17 @@ proptest! {
     #![proptest_config(ProptestConfig::with_cases(200))]
 
     #[test]
-    fn arbitrary_samples_never_panic(samples in prop::collection::vec(sample(), 0..3000), rate in 100u32..=1000) {
+    fn arbitrary_samples_never_panic(samples in prop::collection::vec(sample(), 0..3000), rate in 50u32..=1000) {
         check::<1024>(&samples, rate, &[]);
     }
 
     #[test]
-    fn runs_and_gaps_never_panic(samples in runs(), rate in 100u32..=1000, gaps in prop::collection::vec((0usize..5000, 0u32..100_000), 0..5)) {
+    fn runs_and_gaps_never_panic(samples in runs(), rate in 50u32..=1000, gaps in prop::collection::vec((0usize..5000, 0u32..100_000), 0..5)) {
         check::<1024>(&samples, rate, &gaps);
     }
 
     #[test]
-    fn a_small_movement_buffer_flags_instead_of_growing(samples in runs(), rate in 100u32..=1000) {
+    fn a_small_movement_buffer_flags_instead_of_growing(samples in runs(), rate in 50u32..=1000) {
         check::<32>(&samples, rate, &[]);
     }
 

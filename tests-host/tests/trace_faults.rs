@@ -181,6 +181,31 @@ fn a_short_hole_in_a_swing_is_bridged_and_the_stride_measured() {
     others_unchanged(&whole, &got, mid.index);
 }
 
+/// `g` is estimated: flagged, and its length the mean of the two gait cycles measured last
+/// before it in `all` (valid, not from or into a rest, no gap), to the millimetre.
+fn assert_estimated(g: &StrideReport, all: &[StrideReport]) {
+    let before: Vec<f64> = all
+        .iter()
+        .filter(|s| s.index < g.index)
+        .filter(|s| {
+            s.valid
+                && !s
+                    .flags
+                    .iter()
+                    .any(|f| ["from_rest", "to_rest", "gap"].contains(f))
+        })
+        .map(|s| s.length_m)
+        .collect();
+    assert!(before.len() >= 2, "{g:?}");
+    let want = (before[before.len() - 2] + before[before.len() - 1]) / 2.0;
+    assert!(g.flags.contains(&"estimated"), "{g:?}");
+    assert!(
+        (g.length_m - want).abs() <= 0.0011,
+        "{} vs {want}",
+        g.length_m
+    );
+}
+
 #[test]
 fn a_longer_hole_makes_a_gap_stride_that_keeps_its_events_outside_the_hole() {
     let whole = replay(&demo(), Ranges::default()).unwrap();
@@ -192,7 +217,9 @@ fn a_longer_hole_makes_a_gap_stride_that_keeps_its_events_outside_the_hole() {
     let hole_s = at as f64 / 200.0;
     let g = got.iter().find(|g| g.index == mid.index).unwrap();
     assert!(g.flags.contains(&"gap") && !g.valid, "{g:?}");
-    assert_eq!(g.length_m, 0.0);
+    // No length measured across the hole (the filled movement's displacement is not one):
+    // the length is the estimate.
+    assert_estimated(g, &got);
     // Heel-off and foot-flat are measured as without the hole; toe-off (before the hole)
     // and heel-strike (after it) are found on the interpolated movement. The demo's smooth
     // feet have no sharp peak-valley pairs (`phases_guessed`: cluster centres), so the
@@ -231,9 +258,10 @@ fn a_hole_too_long_to_fill_restarts_detection_and_the_stride_is_a_gap() {
         .find(|s| s.start_s < hole_s && hole_s < s.end_s)
         .expect("the stride over the hole is reported");
     assert!(
-        g.flags.contains(&"gap") && !g.valid && g.length_m == 0.0,
+        g.flags.contains(&"gap") && !g.valid && g.zupt_m == 0.0,
         "{g:?}"
     );
+    assert_estimated(g, &got);
     assert!((g.start_s - mid.start_s).abs() < 1e-9, "{g:?} vs {mid:?}");
     assert!(
         (g.heel_off_s - mid.heel_off_s).abs() < 1e-9,
@@ -274,17 +302,43 @@ fn samples_at_the_rails_flag_the_stride() {
     let whole = replay(&demo(), Ranges::default()).unwrap();
     let mut t = demo();
     let mid = &whole[whole.len() / 2];
-    // A heel strike harder than ±16 g: the sensor reads its rail.
+    // A heel strike of 12 g read at ±8 g: the accelerometer sits at its rail, what it lost
+    // is put back and the stride stays valid, within 2 cm of the same spike read at ±16 g
+    // (unclipped).
     let i = (mid.heel_strike_s * 200.0).round() as usize;
-    t.samples[i].acc_mps2[2] = 20.0 * G_MPS2;
-    let got = replay(&t, Ranges::default()).unwrap();
+    t.samples[i].acc_mps2[2] = 12.0 * G_MPS2;
+    let spike16 = replay(&t, Ranges::default()).unwrap();
+    let at8 = Ranges {
+        accel: gaitclip::sample::AccelRange::G8,
+        ..Ranges::default()
+    };
+    let got = replay(&t, at8).unwrap();
     let g = got.iter().find(|s| s.index == mid.index).unwrap();
-    assert!(g.flags.contains(&"saturated"), "{g:?}");
-    assert!(!g.valid);
-    // Only that stride.
-    assert_eq!(
-        got.iter().filter(|s| !s.valid).count(),
-        whole.iter().filter(|s| !s.valid).count() + 1
+    let w = spike16.iter().find(|s| s.index == mid.index).unwrap();
+    assert!(g.flags.contains(&"accel_clipped") && g.valid, "{g:?}");
+    assert!(
+        (g.length_m - w.length_m).abs() <= 0.02,
+        "{} vs {} unclipped",
+        g.length_m,
+        w.length_m
+    );
+    assert_eq!(got.len(), whole.len());
+    // Huang's stance detector restores nothing: the stride is saturated, and estimated.
+    let stance = gaitclip_host::replay::replay_model(
+        &t,
+        at8,
+        gaitclip::pipeline::Detector::Stance,
+        gaitclip::pipeline::DEFAULT_MODEL,
+        false,
+    )
+    .unwrap();
+    let s = stance
+        .iter()
+        .find(|s| s.heel_off_s <= mid.heel_strike_s && mid.heel_strike_s <= s.end_s)
+        .unwrap();
+    assert!(
+        s.flags.contains(&"saturated") && s.flags.contains(&"estimated") && s.length_m > 0.0,
+        "{s:?}"
     );
     // The gyro rail (±2000 °/s = 34.9 rad/s) is flagged, and the stride stays valid: the
     // tilt the rail lost is put back on the clipped samples.
