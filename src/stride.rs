@@ -119,7 +119,7 @@ impl StrideFlags {
     pub const BRIDGED: u16 = 1 << 8;
     /// The gyroscope sat at a rail in the movement; the tilt the clipped rates lost was
     /// restored from the end stance's gravity
-    /// ([`crate::zupt::ZuptIntegrator::displacement_restoring_tilt`]): the length stays
+    /// ([`crate::zupt::ZuptIntegrator::displacement_restoring`]): the length stays
     /// valid (informational).
     pub const GYRO_CLIPPED: u16 = 1 << 9;
     /// The accelerometer sat at a rail in the movement; what it lost was put back where it

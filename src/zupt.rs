@@ -113,7 +113,7 @@ pub struct ZuptIntegrator {
     position_x2_q8: [i64; 3],
     samples: u32,
     /// Samples with a gyro axis at a rail, and for them Σ c and Σ c² (`c`: the sample's
-    /// count, 1-based), for [`ZuptIntegrator::displacement_restoring_tilt`].
+    /// count, 1-based), for [`ZuptIntegrator::displacement_restoring`].
     clipped: u32,
     clipped_c: i64,
     clipped_c2: i64,

@@ -7,7 +7,7 @@
 //!   zero-velocity update. A clip on the side of a shoe sits lower than one on the laces.
 //! - **Gyro full-scale range**: the recordings are converted to MPU6050 counts at ±2000,
 //!   ±500 and ±250 °/s; at the lower ranges the swing's pitch rate clips and the tilt the
-//!   rails lost is put back ([`gaitclip::zupt::ZuptIntegrator::displacement_restoring_tilt`]),
+//!   rails lost is put back ([`gaitclip::zupt::ZuptIntegrator::displacement_restoring`]),
 //!   reported for clipped and unclipped strides apart.
 //!
 //! Scored as `gaitclip eval` scores the `zupt` model: the cycle detector's valid strides
