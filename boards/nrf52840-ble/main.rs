@@ -331,7 +331,7 @@ async fn battery_task(mut adc: saadc::Saadc<'static, 1>) -> ! {
 
 #[embassy_executor::task]
 async fn ble_task(controller: nrf_sdc::SoftdeviceController<'static>, address: BleAddress) -> ! {
-    rsc_gatt::run(controller, address, &POD).await
+    rsc_gatt::run(controller, address, &POD, &rsc_gatt::DefmtObserver).await
 }
 
 /// The static random address from the chip's FICR (its two top bits set, as the Core

@@ -12,12 +12,17 @@
 //! |---|---|---|---|
 //! | 1 | flags: bit 0 stride length present, bit 1 total distance present, bit 2 running | | [`Gait::Running`] sets bit 2 |
 //! | 2 | instantaneous speed | 1/256 m/s | [`gaitclip::gait::GaitParameters::gait_velocity_mm_s`] |
-//! | 1 | instantaneous cadence | steps/min | [`gaitclip::gait::GaitParameters::cadence_spm`] (saturated at 255) |
+//! | 1 | instantaneous cadence | 1/min: the sensor's foot's contacts, strides per minute | half [`gaitclip::gait::GaitParameters::cadence_spm`], rounded (saturated at 255) |
 //! | 2 | instantaneous stride length (if bit 0) | cm | [`Stride::length_mm`], for a stride that counts in the distance (measured, or estimated) |
 //! | 4 | total distance (if bit 1) | dm | [`FootPod::total_distance_dm`] |
 //!
-//! A stride (two steps, heel-strike to heel-strike of one foot) is what RSC's "stride length"
-//! is; the cadence counts steps of both feet, as the watches that read RSC show it.
+//! **Cadence and stride, as RSCS 1.0 defines them**: "the cadence represents the number of
+//! times per minute the foot with the sensor hits the ground" and "the stride length
+//! represents the distance between two successive contacts of the same foot to the ground"
+//! (RSCS v1.0, 2012-08-07, §2 and the RSC Measurement characteristic). Both are per stride of
+//! the instrumented foot: the cadence sent is strides per minute, half the steps per minute
+//! of both feet ([`gaitclip::gait::GaitParameters::cadence_spm`]) that the logs and the
+//! JSON give. Consumers differ in what they make of it: the README's interoperability table.
 
 use gaitclip::gait::Gait;
 use gaitclip::stride::Stride;
@@ -79,8 +84,8 @@ pub const STANDING_EVERY_MS: u32 = 1000;
 pub struct Measurement {
     /// Instantaneous speed, 1/256 m/s.
     pub speed_256ths_m_s: u16,
-    /// Instantaneous cadence, steps per minute.
-    pub cadence_spm: u8,
+    /// Instantaneous cadence, 1/min: contacts of the sensor's foot (strides) per minute.
+    pub cadence_per_min: u8,
     /// Instantaneous stride length, cm (absent for a stride without a length).
     pub stride_length_cm: Option<u16>,
     /// Total distance, dm.
@@ -97,7 +102,8 @@ impl Measurement {
         Measurement {
             // mm/s · 256/1000, rounded: at most 65 535 mm/s → 16 777 < 2¹⁶.
             speed_256ths_m_s: ((g.gait_velocity_mm_s as u32 * 256 + 500) / 1000) as u16,
-            cadence_spm: g.cadence_spm.min(u8::MAX as u16) as u8,
+            // Steps of both feet to the sensor's foot's contacts: half, rounded.
+            cadence_per_min: g.cadence_spm.div_ceil(2).min(u8::MAX as u16) as u8,
             stride_length_cm: has_length
                 .then(|| ((stride.length_mm + 5) / 10).min(u16::MAX as u32) as u16),
             total_distance_dm: Some(total_distance_dm),
@@ -109,7 +115,7 @@ impl Measurement {
     pub const fn standing(total_distance_dm: u32) -> Self {
         Measurement {
             speed_256ths_m_s: 0,
-            cadence_spm: 0,
+            cadence_per_min: 0,
             stride_length_cm: None,
             total_distance_dm: Some(total_distance_dm),
             running: false,
@@ -130,7 +136,7 @@ impl Measurement {
         }
         buf[0] = flags;
         buf[1..3].copy_from_slice(&self.speed_256ths_m_s.to_le_bytes());
-        buf[3] = self.cadence_spm;
+        buf[3] = self.cadence_per_min;
         let mut n = 4;
         if let Some(cm) = self.stride_length_cm {
             buf[n..n + 2].copy_from_slice(&cm.to_le_bytes());
@@ -159,7 +165,12 @@ pub enum ControlPointRefusal {
     CccdImproperlyConfigured,
     /// An empty write: no op code (ATT error 0x0D, invalid attribute value length).
     Empty,
+    /// A write longer than any procedure's ([`CONTROL_POINT_MAX_LEN`]; ATT error 0x0D).
+    TooLong,
 }
+
+/// The longest SC Control Point write: Set Cumulative Value, op code and a `u32`.
+pub const CONTROL_POINT_MAX_LEN: usize = 5;
 
 impl ControlPointRefusal {
     /// The ATT error code.
@@ -167,7 +178,7 @@ impl ControlPointRefusal {
         match self {
             ControlPointRefusal::ProcedureAlreadyInProgress => 0x80,
             ControlPointRefusal::CccdImproperlyConfigured => 0x81,
-            ControlPointRefusal::Empty => 0x0D,
+            ControlPointRefusal::Empty | ControlPointRefusal::TooLong => 0x0D,
         }
     }
 }
@@ -250,6 +261,9 @@ impl FootPod {
         if self.procedure_pending {
             return Err(ControlPointRefusal::ProcedureAlreadyInProgress);
         }
+        if value.len() > CONTROL_POINT_MAX_LEN {
+            return Err(ControlPointRefusal::TooLong);
+        }
         let (&op, parameter) = value.split_first().ok_or(ControlPointRefusal::Empty)?;
         let result = match op {
             OP_SET_CUMULATIVE_VALUE => match <[u8; 4]>::try_from(parameter) {
@@ -265,6 +279,11 @@ impl FootPod {
         };
         self.procedure_pending = true;
         Ok([OP_RESPONSE, op, result])
+    }
+
+    /// A control-point response is waiting for its indication's confirmation.
+    pub const fn procedure_pending(&self) -> bool {
+        self.procedure_pending
     }
 
     /// The control-point response was indicated (confirmed, or the link is gone): the next

@@ -10,6 +10,13 @@
 //! [`FootPod`] behind the link, the measurements queue in a small channel that the Bluetooth
 //! task empties when a central connects (stale notifications are not replayed), and the
 //! serial/defmt log does not depend on any of it.
+//!
+//! **One path for board and host.** [`run`] is what the nRF52840 build runs over Nordic's
+//! controller and what `gaitclip pod` runs on the host over an HCI transport (a Bumble
+//! virtual controller, or a real one over a UART); they differ in the controller, the
+//! executor, the clock (`embassy-time`'s driver), the battery source
+//! ([`PodLink::set_battery_percent`]) and what hears the Bluetooth events ([`PodObserver`]:
+//! defmt on the board, lines on stdout on the host).
 
 use core::cell::RefCell;
 use core::sync::atomic::{AtomicBool, AtomicU32, AtomicU8, Ordering};
@@ -51,6 +58,100 @@ pub const SLEEPING_ADVERTISING_INTERVAL_MS: u64 = 2000;
 /// The name in the advertising data and the GAP service.
 pub const DEVICE_NAME: &str = "gaitclip";
 
+/// What happened on the Bluetooth side, for a log ([`PodObserver`]).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum PodEvent<'a> {
+    /// Advertising started, at this interval.
+    Advertising {
+        /// Advertising interval, ms.
+        interval_ms: u64,
+    },
+    /// Advertising could not start or a connection failed; retried in a second.
+    AdvertisingFailed,
+    /// A central connected.
+    Connected,
+    /// The central wrote the RSC Measurement's CCCD: notifications on or off.
+    Subscribed {
+        /// Notifications on.
+        notify: bool,
+    },
+    /// The central wrote the SC Control Point's CCCD: indications on or off.
+    ControlPointSubscribed {
+        /// Indications on.
+        indicate: bool,
+    },
+    /// An RSC Measurement was notified (its bytes).
+    Notified {
+        /// The characteristic value sent.
+        value: &'a [u8],
+    },
+    /// A write to the SC Control Point and what the pod answered: the indication it sends,
+    /// or the ATT error it rejected the write with.
+    ControlPoint {
+        /// The value written.
+        request: &'a [u8],
+        /// `Ok(indication)` or `Err(ATT error code)`.
+        answer: Result<&'a [u8], u8>,
+    },
+    /// The control point's indication was confirmed by the central (or the link closed).
+    IndicationDone,
+    /// The link closed (by either side, or lost), with the HCI reason code.
+    Disconnected {
+        /// HCI reason (0x13 remote user terminated, 0x08 connection timeout, …).
+        reason: u8,
+    },
+}
+
+/// Hears the Bluetooth events of [`run`]: a board logs them over defmt, the host pod prints
+/// them. Called from the Bluetooth task; must not block.
+pub trait PodObserver {
+    /// One event.
+    fn event(&self, event: PodEvent<'_>);
+}
+
+/// Logs the events over defmt (on a Cortex-M; nothing elsewhere).
+pub struct DefmtObserver;
+
+impl PodObserver for DefmtObserver {
+    fn event(&self, event: PodEvent<'_>) {
+        #[cfg(not(target_os = "none"))]
+        let _ = event;
+        #[cfg(target_os = "none")]
+        match event {
+            PodEvent::Advertising { interval_ms } => {
+                ble_log!(info, "BLE: advertising every {=u64} ms", interval_ms)
+            }
+            PodEvent::AdvertisingFailed => ble_log!(warn, "BLE: advertising failed; retrying"),
+            PodEvent::Connected => ble_log!(info, "BLE: central connected"),
+            PodEvent::Subscribed { notify } => {
+                ble_log!(info, "BLE: RSC notifications {=bool}", notify)
+            }
+            PodEvent::ControlPointSubscribed { indicate } => {
+                ble_log!(info, "BLE: control point indications {=bool}", indicate)
+            }
+            PodEvent::Notified { value } => ble_log!(debug, "BLE: notified {=[u8]:x}", value),
+            PodEvent::ControlPoint { request, answer } => match answer {
+                Ok(ind) => ble_log!(
+                    info,
+                    "BLE: control point {=[u8]:x} -> {=[u8]:x}",
+                    request,
+                    ind
+                ),
+                Err(code) => ble_log!(
+                    info,
+                    "BLE: control point {=[u8]:x} refused {=u8:x}",
+                    request,
+                    code
+                ),
+            },
+            PodEvent::IndicationDone => ble_log!(debug, "BLE: indication confirmed"),
+            PodEvent::Disconnected { reason } => {
+                ble_log!(info, "BLE: disconnected ({=u8:x})", reason)
+            }
+        }
+    }
+}
+
 /// The attribute table, as trouble's `#[gatt_server]` and `#[gatt_service]` build it (the
 /// macros do not carry doc comments over to what they generate, hence the `allow`).
 #[allow(missing_docs)]
@@ -82,7 +183,7 @@ pub mod table {
         pub location: u8,
         /// SC Control Point: Set Cumulative Value.
         #[characteristic(uuid = characteristic::SC_CONTROL_POINT, write, indicate)]
-        pub control_point: heapless::Vec<u8, 5>,
+        pub control_point: heapless::Vec<u8, { rsc::CONTROL_POINT_MAX_LEN }>,
     }
 
     /// Battery Service.
@@ -161,6 +262,8 @@ pub struct PodLink {
     notified: AtomicU32,
     /// Connections so far.
     connections: AtomicU32,
+    /// The connected central has RSC Measurement notifications on.
+    subscribed: AtomicBool,
     /// The clip sleeps ([`crate::sleep`]): advertise slowly.
     asleep: AtomicBool,
     /// Raised when `asleep` changes, to restart advertising at the other interval.
@@ -183,6 +286,7 @@ impl PodLink {
             unqueued: AtomicU32::new(0),
             notified: AtomicU32::new(0),
             connections: AtomicU32::new(0),
+            subscribed: AtomicBool::new(false),
             asleep: AtomicBool::new(false),
             asleep_changed: Signal::new(),
         }
@@ -224,6 +328,12 @@ impl PodLink {
             .store(percent.min(100), Ordering::Relaxed);
     }
 
+    /// Whether a connected central has RSC Measurement notifications on (a host replay can
+    /// wait for it, so that every stride is seen).
+    pub fn subscribed(&self) -> bool {
+        self.subscribed.load(Ordering::Relaxed)
+    }
+
     /// (notifications sent, measurements not queued, connections).
     pub fn counters(&self) -> (u32, u32, u32) {
         (
@@ -239,8 +349,14 @@ impl PodLink {
 }
 
 /// Runs the Bluetooth side forever: the host stack on `controller`, advertising, one
-/// connection at a time, and advertising again after a disconnection or a link loss.
-pub async fn run<C: Controller>(controller: C, address: Address, link: &PodLink) -> ! {
+/// connection at a time, and advertising again after a disconnection or a link loss; every
+/// event to `observer`.
+pub async fn run<C: Controller>(
+    controller: C,
+    address: Address,
+    link: &PodLink,
+    observer: &impl PodObserver,
+) -> ! {
     let mut resources: HostResources<DefaultPacketPool, CONNECTIONS_MAX, L2CAP_CHANNELS_MAX> =
         HostResources::new();
     let stack = trouble_host::new(controller, &mut resources)
@@ -271,6 +387,9 @@ pub async fn run<C: Controller>(controller: C, address: Address, link: &PodLink)
         loop {
             link.asleep_changed.reset();
             let interval = link.advertising_interval_ms();
+            observer.event(PodEvent::Advertising {
+                interval_ms: interval,
+            });
             let advertised = select(
                 advertise(&mut peripheral, &server, interval),
                 link.asleep_changed.wait(),
@@ -283,11 +402,11 @@ pub async fn run<C: Controller>(controller: C, address: Address, link: &PodLink)
             match advertised {
                 Ok(conn) => {
                     link.connections.fetch_add(1, Ordering::Relaxed);
-                    ble_log!(info, "BLE: central connected");
+                    observer.event(PodEvent::Connected);
                     // What queued while nobody listened is history: the total carries it.
                     link.measurements.clear();
-                    serve(&server, &conn, link).await;
-                    ble_log!(info, "BLE: disconnected; advertising again");
+                    serve(&server, &conn, link, observer).await;
+                    link.subscribed.store(false, Ordering::Relaxed);
                 }
                 Err(e) => {
                     ble_log!(
@@ -296,6 +415,7 @@ pub async fn run<C: Controller>(controller: C, address: Address, link: &PodLink)
                         defmt::Debug2Format(&e)
                     );
                     let _ = e;
+                    observer.event(PodEvent::AdvertisingFailed);
                     Timer::after(Duration::from_secs(1)).await;
                 }
             }
@@ -345,18 +465,57 @@ async fn advertise<'values, 'server, C: Controller>(
 }
 
 /// One connection: GATT events, the queued measurements and the standing notifications,
-/// until it closes.
+/// until it closes. A control-point answer is indicated by a second loop beside the first,
+/// so that a write arriving before the central confirmed the indication is seen, and refused
+/// (0x80, procedure already in progress), while the indication waits for its confirmation.
 async fn serve<P: PacketPool>(
     server: &FootPodServer<'_>,
     conn: &GattConnection<'_, '_, P>,
     link: &PodLink,
+    observer: &impl PodObserver,
+) {
+    let rsc = &server.rsc;
+    let indications_to_send: Signal<CriticalSectionRawMutex, heapless::Vec<u8, 5>> = Signal::new();
+    let events = serve_events(server, conn, link, observer, &indications_to_send);
+    let indicate = async {
+        loop {
+            let v = indications_to_send.wait().await;
+            if let Err(e) = rsc.control_point.indicate(conn, &v, false).await {
+                ble_log!(
+                    warn,
+                    "BLE: control-point indication failed: {}",
+                    defmt::Debug2Format(&e)
+                );
+                let _ = e;
+            }
+            link.pod.lock(|p| p.borrow_mut().indication_done());
+            observer.event(PodEvent::IndicationDone);
+        }
+    };
+    // The event loop ends with the connection; the indication loop never does.
+    select(events, indicate).await;
+}
+
+/// The event loop of [`serve`].
+async fn serve_events<P: PacketPool>(
+    server: &FootPodServer<'_>,
+    conn: &GattConnection<'_, '_, P>,
+    link: &PodLink,
+    observer: &impl PodObserver,
+    indications_to_send: &Signal<CriticalSectionRawMutex, heapless::Vec<u8, 5>>,
 ) {
     let rsc = &server.rsc;
     let cp_cccd = rsc.control_point.cccd_handle().map(|h| h.handle());
+    let measurement_cccd = rsc.measurement.cccd_handle().map(|h| h.handle());
     // trouble-host 0.8's `Characteristic::should_indicate` reads the notify bit, so the
     // control point's CCCD is followed here from the client's writes.
     let mut indications = false;
-    let mut battery_sent = None;
+    // The level a central reads is the link's from the start, not the table's initial value;
+    // it is notified when it changes.
+    let mut battery_sent = Some(link.battery_percent.load(Ordering::Relaxed));
+    if let Some(level) = battery_sent {
+        let _ = server.set(&server.battery.level, &level);
+    }
     loop {
         let next = select(
             conn.next(),
@@ -366,88 +525,130 @@ async fn serve<P: PacketPool>(
             ),
         )
         .await;
+        if let Either::First(GattConnectionEvent::Gatt {
+            event: GattEvent::Write(w),
+        }) = &next
+        {
+            if w.handle() == rsc.control_point.handle
+                && link.pod.lock(|p| p.borrow().procedure_pending())
+            {
+                // The host handles the central's PDUs in order: a confirmation it sent before
+                // this write has woken the indication loop already. Let that loop finish the
+                // procedure before the write is judged, so that only a write that really
+                // came before the confirmation is refused as a procedure in progress.
+                for _ in 0..4 {
+                    embassy_futures::yield_now().await;
+                }
+            }
+        }
         match next {
             Either::First(GattConnectionEvent::Disconnected { reason }) => {
-                ble_log!(info, "BLE: link closed ({})", defmt::Debug2Format(&reason));
-                let _ = reason;
+                observer.event(PodEvent::Disconnected {
+                    reason: reason.into_inner(),
+                });
                 link.pod.lock(|p| p.borrow_mut().indication_done());
                 return;
             }
             Either::First(GattConnectionEvent::Gatt { event }) => {
                 let mut response = None;
+                let mut refused = None;
                 let reply = match &event {
                     GattEvent::Write(w) if Some(w.handle()) == cp_cccd => {
                         indications = w.with_data(|_, d| d.first().is_some_and(|b| b & 0x02 != 0));
+                        observer.event(PodEvent::ControlPointSubscribed {
+                            indicate: indications,
+                        });
+                        event.accept()
+                    }
+                    GattEvent::Write(w) if Some(w.handle()) == measurement_cccd => {
+                        let on = w.with_data(|_, d| d.first().is_some_and(|b| b & 0x01 != 0));
+                        link.subscribed.store(on, Ordering::Relaxed);
+                        observer.event(PodEvent::Subscribed { notify: on });
                         event.accept()
                     }
                     GattEvent::Write(w) if w.handle() == rsc.control_point.handle => {
+                        let mut request = heapless::Vec::<u8, 8>::new();
                         let answer = w.with_data(|_, d| {
+                            let _ = request.extend_from_slice(&d[..d.len().min(8)]);
                             link.pod
                                 .lock(|p| p.borrow_mut().control_point(d, indications))
                         });
                         match answer {
                             Ok(r) => {
                                 response = Some(r);
+                                observer.event(PodEvent::ControlPoint {
+                                    request: &request,
+                                    answer: Ok(&r),
+                                });
                                 event.accept()
                             }
-                            Err(refusal) => event.reject(AttErrorCode::new(refusal.att_error())),
+                            Err(refusal) => {
+                                refused = Some(refusal.att_error());
+                                observer.event(PodEvent::ControlPoint {
+                                    request: &request,
+                                    answer: Err(refusal.att_error()),
+                                });
+                                event.reject(AttErrorCode::new(refusal.att_error()))
+                            }
                         }
                     }
                     _ => event.accept(),
                 };
+                let _ = refused;
                 if let Ok(reply) = reply {
                     reply.send().await;
                 }
                 if let Some(r) = response {
                     let mut v = heapless::Vec::new();
                     let _ = v.extend_from_slice(&r);
-                    if let Err(e) = rsc.control_point.indicate(conn, &v, false).await {
-                        ble_log!(
-                            warn,
-                            "BLE: control-point indication failed: {}",
-                            defmt::Debug2Format(&e)
-                        );
-                        let _ = e;
-                    }
-                    link.pod.lock(|p| p.borrow_mut().indication_done());
+                    indications_to_send.signal(v);
                 }
             }
             Either::First(_) => {}
-            Either::Second(Either::First(m)) => notify(rsc, conn, link, &m).await,
+            Either::Second(Either::First(m)) => notify(rsc, conn, link, observer, &m).await,
             Either::Second(Either::Second(())) => {
                 let standing = link
                     .pod
                     .lock(|p| p.borrow_mut().standing_due(PodLink::now_ms()));
                 if let Some(m) = standing {
-                    notify(rsc, conn, link, &m).await;
+                    notify(rsc, conn, link, observer, &m).await;
                 }
                 let level = link.battery_percent.load(Ordering::Relaxed);
-                if battery_sent != Some(level)
-                    && server
+                if battery_sent != Some(level) {
+                    let _ = server.set(&server.battery.level, &level);
+                    if server
                         .battery
                         .level
                         .notify(conn, &level, true)
                         .await
                         .is_ok()
-                {
-                    battery_sent = Some(level);
+                    {
+                        battery_sent = Some(level);
+                    }
                 }
             }
         }
     }
 }
 
+/// Notifies `m` if the central subscribed (a measurement before the subscription is not
+/// sent: the total distance carries it).
 async fn notify<P: PacketPool>(
     rsc: &RscService,
     conn: &GattConnection<'_, '_, P>,
     link: &PodLink,
+    observer: &impl PodObserver,
     m: &Measurement,
 ) {
+    if !rsc.measurement.should_notify(conn) {
+        return;
+    }
     let mut buf = [0u8; MAX_MEASUREMENT_LEN];
     let n = m.encode(&mut buf);
     let mut v = heapless::Vec::new();
     let _ = v.extend_from_slice(&buf[..n]);
     if rsc.measurement.notify(conn, &v, false).await.is_ok() {
         link.notified.fetch_add(1, Ordering::Relaxed);
+        observer.event(PodEvent::Notified { value: &buf[..n] });
     }
 }
