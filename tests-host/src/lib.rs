@@ -29,6 +29,7 @@ pub mod matching;
 pub mod mcap_io;
 pub mod peak_valley_ref;
 pub mod plot;
+pub mod pod;
 pub mod qemu;
 pub mod rails;
 pub mod rate_sweep;

@@ -544,7 +544,9 @@ pub fn replay_summarised(
     Ok((out, summary))
 }
 
-fn report(s: Stride, config: Config, t_s: &impl Fn(u32) -> f64) -> StrideReport {
+/// The host's report of a core stride `s` made with `config`, times by `t_s` (sample number to
+/// the trace's clock).
+pub fn report(s: Stride, config: Config, t_s: &impl Fn(u32) -> f64) -> StrideReport {
     StrideReport {
         index: s.index,
         start_s: t_s(s.start),

@@ -48,7 +48,7 @@ fn measurement_matches_nordics_test_vector() {
     // cadence 18, stride 86 cm, total 0xF0000001 dm, in 10 bytes.
     let m = Measurement {
         speed_256ths_m_s: 3 * 256,
-        cadence_spm: 18,
+        cadence_per_min: 18,
         stride_length_cm: Some(86),
         total_distance_dm: Some(0xF000_0001),
         running: true,
@@ -86,20 +86,22 @@ fn stride(length_mm: u32, gait: Gait, flags: u16) -> Stride {
 #[test]
 fn stride_to_notification_field_by_field() {
     let mut pod = FootPod::new();
-    // 1.40 m in 1.1 s: 1.273 m/s = 325.8/256, 109 steps/min.
+    // 1.40 m in 1.1 s: 1.273 m/s = 325.8/256, 109 steps/min of both feet, 55 contacts of the
+    // sensor's foot per minute (RSCS's cadence).
     let s = stride(1400, Gait::Walking, 0);
     let m = pod.stride(&s, 5000);
     assert_eq!(s.gait.gait_velocity_mm_s, 1273);
     assert_eq!(m.speed_256ths_m_s, 326);
-    assert_eq!(m.cadence_spm, 109);
+    assert_eq!(s.gait.cadence_spm, 109);
+    assert_eq!(m.cadence_per_min, 55);
     assert_eq!(m.stride_length_cm, Some(140));
     assert_eq!(m.total_distance_dm, Some(14));
     let bytes = encode(&m);
-    assert_eq!(bytes, [0x03, 0x46, 0x01, 109, 140, 0, 14, 0, 0, 0]);
+    assert_eq!(bytes, [0x03, 0x46, 0x01, 55, 140, 0, 14, 0, 0, 0]);
     let (running, speed, cadence, cm, dm) = nordic_decode(&bytes).unwrap();
     assert!(!running);
     assert!((speed - 1.273).abs() < 1.0 / 256.0);
-    assert_eq!((cadence, cm, dm), (109, Some(140), Some(14)));
+    assert_eq!((cadence, cm, dm), (55, Some(140), Some(14)));
 
     // Running sets bit 2; the distance keeps adding up, in dm of the mm total.
     let m = pod.stride(&stride(2650, Gait::Running, 0), 5700);
@@ -121,7 +123,7 @@ fn speed_and_cadence_saturate() {
     s.gait.cadence_spm = 600;
     let m = Measurement::of_stride(&s, u32::MAX);
     assert_eq!(m.speed_256ths_m_s, 16_777);
-    assert_eq!(m.cadence_spm, 255);
+    assert_eq!(m.cadence_per_min, 255);
     assert_eq!(&encode(&m)[6..], &[0xFF; 4]);
 }
 
@@ -197,10 +199,16 @@ fn control_point_state_machine() {
         pod.indication_done();
     }
     // A Set Cumulative Value without its 4-byte parameter.
-    for bad in [&[0x01][..], &[0x01, 1, 2, 3], &[0x01, 1, 2, 3, 4, 5]] {
+    for bad in [&[0x01][..], &[0x01, 1, 2, 3]] {
         assert_eq!(pod.control_point(bad, true), Ok([0x10, 0x01, 0x03]));
         pod.indication_done();
     }
+    // Longer than any procedure's 5 bytes: refused at the ATT level, as an empty write.
+    assert_eq!(
+        pod.control_point(&[0x01, 1, 2, 3, 4, 5], true),
+        Err(ControlPointRefusal::TooLong)
+    );
+    assert_eq!(ControlPointRefusal::TooLong.att_error(), 0x0D);
     assert_eq!(
         pod.total_distance_dm(),
         10_014,

@@ -62,6 +62,35 @@ enum Cmd {
         #[arg(long, value_name = "DPS")]
         gyro_range_dps: Option<f64>,
     },
+    /// The Bluetooth foot pod on the host: the pod's own Bluetooth code over an HCI
+    /// controller, serving the strides of a replayed recording as the board serves a walk.
+    Pod {
+        /// The HCI controller: `tcp:HOST:PORT` (an H4 controller listening on TCP, such as
+        /// Bumble's `tcp-server:`) or `serial:PATH[@BAUD]` (a UART controller; 1000000 baud
+        /// by default).
+        #[arg(long, value_name = "TRANSPORT", value_parser = hci_transport)]
+        hci: gaitclip_host::pod::Hci,
+        /// The recording to replay (CSV or MCAP, as `replay` reads them).
+        trace: PathBuf,
+        /// Sample rate in Hz (default: meta.json beside a CSV, else the timestamps).
+        #[arg(long)]
+        rate: Option<f64>,
+        /// Replay this many times faster than real time.
+        #[arg(long, default_value_t = 1.0)]
+        speed: f64,
+        /// Hold the replay until a central has subscribed to RSC Measurement.
+        #[arg(long)]
+        wait_for_central: bool,
+        /// The battery level served, % (the board reads its supply).
+        #[arg(long, default_value_t = 100, value_parser = clap::value_parser!(u8).range(0..=100))]
+        battery_percent: u8,
+        /// Step detector, as for `replay`.
+        #[arg(long, value_name = "NAME", value_parser = detector_names(), default_value = Detector::Cycle.name())]
+        detector: String,
+        /// Strides and Bluetooth events as JSON lines.
+        #[arg(long)]
+        json: bool,
+    },
     /// Score stride detection, gait events, phases and stance against the ground truth of
     /// dataset folders (`../shared/datasets/<name>`); prints Markdown tables.
     Eval {
@@ -326,6 +355,10 @@ fn main() -> ExitCode {
     }
 }
 
+fn hci_transport(s: &str) -> Result<gaitclip_host::pod::Hci, String> {
+    s.parse()
+}
+
 fn read_trace(path: &Path, rate: Option<f64>) -> anyhow::Result<Trace> {
     let is_mcap = path
         .extension()
@@ -434,6 +467,34 @@ fn run(cli: Cli) -> anyhow::Result<()> {
                 )?;
                 eprintln!("wrote {}", out.display());
             }
+        }
+        Cmd::Pod {
+            hci,
+            trace,
+            rate,
+            speed,
+            wait_for_central,
+            battery_percent,
+            detector,
+            json,
+        } => {
+            if !(speed.is_finite() && speed > 0.0) {
+                return Err(UsageError("--speed must be a positive number").into());
+            }
+            let detector = Detector::from_name(&detector).context("unknown detector")?;
+            let t = read_trace(&trace, rate)?;
+            gaitclip_host::pod::run(gaitclip_host::pod::PodOptions {
+                hci,
+                trace: t,
+                speed,
+                wait_for_central,
+                battery_percent,
+                configure: Box::new(move |c: &mut Config| {
+                    c.detector = detector;
+                    c.model = detector.length_model(c.model);
+                }),
+                json,
+            })?;
         }
         Cmd::Gait { datasets } => {
             let mut results = Vec::new();
