@@ -51,7 +51,18 @@ cargo fmt --check
 cargo fmt --check --manifest-path fuzz/Cargo.toml
 cargo clippy --workspace --all-targets -- -D warnings
 cargo test --workspace 2>&1 | tee -a "$log"
-# One closing line over every test binary.
+
+echo "== Bluetooth: the foot pod (gaitclip pod) against Bumble's virtual controller and a Bumble central (pytest)"
+# Bumble, pytest and what they pull in, pinned, in a venv of the project's own.
+venv="$root/tests-host/target/ble-venv"
+[ -x "$venv/bin/python" ] || python3 -m venv "$venv"
+"$venv/bin/pip" install --quiet --disable-pip-version-check -r "$root/tests-host/ble/requirements.txt"
+# The binary the cargo tests above built.
+GAITCLIP="$root/tests-host/target/$(rustc -vV | sed -n 's/^host: //p')/debug/gaitclip" \
+  "$venv/bin/python" -m pytest -q -p no:cacheprovider "$root/tests-host/ble" 2>&1 | tee -a "$log"
+
+# One closing line over every test binary and the pytest run.
 awk '/^test result:/ { for (i = 1; i <= NF; i++) { if ($(i) ~ /^passed/) p += $(i-1); if ($(i) ~ /^failed/) f += $(i-1) } }
+     /^[0-9]+ (passed|failed)/ && / in [0-9.]+s/ { for (i = 1; i <= NF; i++) { if ($(i) ~ /^passed/) p += $(i-1); if ($(i) ~ /^failed/) f += $(i-1) } }
      END { printf "tests: %d passed, %d failed\n", p, f }' "$log"
 rm -f "$log"
