@@ -32,8 +32,9 @@
 //! Integer throughout: times in ms from sample counts ([`SampleRate::ms_of_samples`]),
 //! ratios and velocity by rounded integer division.
 
-use crate::rate::SampleRate;
-use crate::stride::{Stride, StrideFlags};
+use crate::record::gait::{Gait, GaitParameters};
+use crate::record::stride::{Stride, StrideFlags};
+use crate::sensor::rate::SampleRate;
 
 /// Stance below this share of the cycle, ‰, is running (a flight phase, duty factor < 0.5).
 pub const RUNNING_STANCE_MAX_PERMILLE: u16 = 500;
@@ -41,50 +42,6 @@ pub const RUNNING_STANCE_MAX_PERMILLE: u16 = 500;
 /// Flags under which the stride's times do not describe one gait cycle: a stride from or
 /// into a rest spans the standing, a gap hides events.
 const NOT_A_CYCLE: u16 = StrideFlags::FROM_REST | StrideFlags::TO_REST | StrideFlags::GAP;
-
-/// Walking or running, by the duty factor.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
-pub enum Gait {
-    /// Stance over [`RUNNING_STANCE_MAX_PERMILLE`] of the cycle: a double support.
-    Walking,
-    /// Stance under [`RUNNING_STANCE_MAX_PERMILLE`]: a flight phase.
-    Running,
-    /// The stride is not one gait cycle (from or into a rest, across a gap).
-    #[default]
-    Unknown,
-}
-
-impl Gait {
-    /// The name the logs and `--json` use.
-    pub const fn name(self) -> &'static str {
-        match self {
-            Gait::Walking => "walking",
-            Gait::Running => "running",
-            Gait::Unknown => "unknown",
-        }
-    }
-}
-
-/// The temporal and derived parameters of one stride.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
-pub struct GaitParameters {
-    /// One gait cycle, `end − start`, ms (saturates at 65.5 s).
-    pub stride_time_ms: u16,
-    /// Ground contact within the cycle, `stride_time − swing_time`, ms.
-    pub stance_time_ms: u16,
-    /// Toe-off to heel-strike, ms.
-    pub swing_time_ms: u16,
-    /// Stance time per stride time, ‰ (0 for a zero stride time).
-    pub stance_permille: u16,
-    /// Swing time per stride time, ‰ (`1000 − stance_permille`; 0 for a zero stride time).
-    pub swing_permille: u16,
-    /// Length per stride time, mm/s (0 without a length or a time; saturates at 65.5 m/s).
-    pub gait_velocity_mm_s: u16,
-    /// Steps per minute: two steps per cycle of the instrumented foot (0 for a zero time).
-    pub cadence_spm: u16,
-    /// Walking or running.
-    pub gait: Gait,
-}
 
 /// The gait-parameter stage: remembers where the last stride ended and its heel-strike, for
 /// the next stride's heel-strike-to-heel-strike time.

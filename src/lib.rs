@@ -10,39 +10,43 @@
 //! through a fixed chain of stages, in this order, each fed only the records of the stage
 //! before it:
 //!
-//! 1. [`mpu6050`] — the driver: one burst read per sample into a [`sample::RawSample`] of
-//!    counts. Nothing later looks at a register.
-//! 2. [`mean_filter`] — a moving average over a power-of-two ring with a running sum.
-//! 3. [`foot_frame`] — which way is up (gravity in the rests that the orientation-free
-//!    [`rest`] test finds) and which way is forward (the axis the foot pitches about in its
+//! 1. [`mpu6050`] — the driver: one burst read per sample into a [`sensor::sample::RawSample`]
+//!    of counts. Nothing later looks at a register.
+//! 2. [`signal::mean_filter`] — a moving average over a power-of-two ring with a running sum.
+//! 3. [`detect::foot_frame`] — which way is up (gravity in the rests that the orientation-free
+//!    [`detect::rest`] test finds) and which way is forward (the axis the foot pitches about in its
 //!    steps); every sample is rotated into that frame by an integer matrix.
-//! 4. [`cycle`] — one zero-velocity instant per gait cycle, at every pace: the deepest
+//! 4. [`detect::cycle`] — one zero-velocity instant per gait cycle, at every pace: the deepest
 //!    minimum of a SHOE-type energy (angular-rate energy plus |f| − g) between two swings,
 //!    found relative to the cycle rather than under a fixed threshold, and confirmed by
 //!    physics (the integrated attitude's up agrees with gravity, the foot is near flat).
-//!    Strides run from instant to instant; the [`zupt`] strapdown integration imposes the
+//!    Strides run from instant to instant; the [`detect::zupt`] strapdown integration imposes the
 //!    rolling-contact velocity `ω × (h·up)` at each instant, and puts back the tilt a
-//!    clipped gyro lost. Huang's [`phases`] splitter gives toe-off and heel-strike, and
-//!    [`phase_stats`] sums the movement's acceleration phase by phase.
-//! 5. [`stance`] and [`stride`] — Huang's variance + IQR stance detector and its
-//!    stance-to-stance segmentation ([`stride::StanceStrides`]), kept selectable as the
-//!    paper's method for the side-by-side tables ([`detector::Detector::Stance`]).
-//! 6. [`features`] — Huang's per-phase features (Table 2) in Q16.
-//! 7. [`models`] — every paper's stride-length model side by side ([`fuzzy`] for Lu's K,
-//!    [`svr`] for Huang's RBF SVRs), with the coefficients and support vectors that
-//!    `gaitclip train` writes into [`trained`]; the pipeline's model fills in the length.
+//!    clipped gyro lost. Huang's [`detect::phases`] splitter gives toe-off and heel-strike, and
+//!    [`detect::phase_stats`] sums the movement's acceleration phase by phase.
+//! 5. [`detect::stance`] and [`detect::stance_strides`] — Huang's variance + IQR stance detector and its
+//!    stance-to-stance segmentation ([`detect::stance_strides::StanceStrides`]), kept selectable as the
+//!    paper's method for the side-by-side tables ([`pipeline::detectors::Detector::Stance`]).
+//! 6. [`length::features`] — Huang's per-phase features (Table 2) in Q16.
+//! 7. [`length::models`] — every paper's stride-length model side by side
+//!    ([`length::fuzzy`] for Lu's K, [`length::svr`] for Huang's RBF SVRs), with the
+//!    coefficients and support vectors that `gaitclip train` writes into
+//!    [`length::trained`]; the pipeline's model fills in the length, and a stride it cannot
+//!    measure gets an estimate from its neighbours ([`length::estimate`]).
+//! 8. [`gait`] — the gait parameters of each stride (stance, swing, cadence, lift, turning),
+//!    the last stage.
 //!
 //! [`pipeline::Pipeline`] composes them; a board or a host tool only feeds samples and
 //! reads strides. Stages 4 and 5 are step detectors behind one seam,
-//! [`detector::StepDetector`]: the pipeline is generic over it, so a firmware links only the
-//! detector it runs, and the host chooses at run time ([`detector::AnyDetector`]). Besides
-//! the cycle detector and Huang's, Lu's [`peak_valley`] detector works on the vertical
-//! acceleration (after the [`low_pass`]) and measures its steps with Lu's own chain; the
+//! [`detect::seam::StepDetector`]: the pipeline is generic over it, so a firmware links only the
+//! detector it runs, and the host chooses at run time ([`pipeline::detectors::AnyDetector`]). Besides
+//! the cycle detector and Huang's, Lu's [`detect::peak_valley`] detector works on the vertical
+//! acceleration (after the [`signal::low_pass`]) and measures its steps with Lu's own chain; the
 //! cycle detector is the default, because it alone gives every cycle of a jog its stance.
 //!
 //! **Units are types where they cross a stage.** The stages take the sensor's scale as
-//! [`units::AccelScale`] and [`units::GyroScale`] (counts per g, per °/s), not the MPU6050's
-//! register enums, and the foot frame hands on [`units::FootAccel`] (g/2048 in the foot
+//! [`sensor::units::AccelScale`] and [`sensor::units::GyroScale`] (counts per g, per °/s), not the MPU6050's
+//! register enums, and the foot frame hands on [`sensor::units::FootAccel`] (g/2048 in the foot
 //! frame), not a bare `[i16; 3]` that a raw gyro reading could be passed as.
 //!
 //! **Integer on the sample path.** The per-sample work is integer arithmetic with documented
@@ -51,13 +55,13 @@
 //! and on the host that replays recordings; tests compare the two.
 //!
 //! **Holes are bridged, not measured across.** A lost packet or a FIFO overflow reaches the
-//! pipeline as [`pipeline::Pipeline::gap`]: a short hole is interpolated ([`bridge`]) and the
+//! pipeline as [`pipeline::Pipeline::gap`]: a short hole is interpolated ([`signal::bridge`]) and the
 //! stride keeps its length (flagged), a longer one makes the stride across it a gap stride
 //! without a length, so that nothing is silently measured across missing samples.
 //!
 //! **No heap, no panics, bounded state.** Every buffer is a compile-time capacity
-//! ([`stance::RING_CAPACITY`], [`pipeline::DELAY_CAPACITY`],
-//! [`stride::MAX_MOVEMENT_SAMPLES`]); a movement longer than its buffer is flagged, never
+//! ([`detect::stance::RING_CAPACITY`], [`detect::seam::DELAY_CAPACITY`],
+//! [`detect::seam::MAX_MOVEMENT_SAMPLES`]); a movement longer than its buffer is flagged, never
 //! grown. Arithmetic that could overflow on hostile input saturates or is bounded by the
 //! capacities.
 //!
@@ -70,40 +74,40 @@
 //! gravity at every stance and measures horizontal distance, which does not depend on yaw.
 //! `gaitclip eval --rotate N` shows the results do not change under random rotations.
 //!
+//! ## Layout
+//!
+//! The folders follow the chain, and a module imports only from folders above it in this
+//! list (`tests-host/tests/import_graph.rs` checks it from the `use` lines):
+//!
+//! | folder | what it holds |
+//! |---|---|
+//! | [`fixed`] | fixed-point arithmetic: Q16/Q30, roots, quaternions, each with its range and error |
+//! | [`sensor`] | what a sample is: counts, scales and rails as types, the rate, where a sample came from |
+//! | [`signal`] | integer signal processing that knows no gait: mean filter, low-pass, hole bridging |
+//! | [`record`] | the records a stride carries out: [`record::stride::Stride`], its flags and events, [`record::gait::GaitParameters`] |
+//! | [`detect`] | finding strides: the detector seam and the three detectors with their stages |
+//! | [`length`] | measuring them: features, models, SVRs, the generated tables, estimates |
+//! | [`gait`] | the gait parameters of a stride |
+//! | [`pipeline`] | the configuration, the detector list, and the composition of it all |
+//!
+//! The driver, [`mpu6050`], sits beside them: nothing in the chain imports it.
+//!
 //! ## Units
 //!
 //! Sample indices count from the first sample fed (gaps included). Lengths are in mm.
-//! The sample rate ([`rate::SampleRate`]) is in millihertz so that 204.8 Hz is exact.
+//! The sample rate ([`sensor::rate::SampleRate`]) is in millihertz so that 204.8 Hz is exact.
 
 #![no_std]
 #![forbid(unsafe_code)]
 #![deny(missing_docs)]
 
-pub mod bridge;
-pub mod clipping;
-pub mod cycle;
-pub mod detector;
-pub mod estimate;
-pub mod features;
+// Alphabetical (rustfmt's order); the chain's order is in the table above.
+pub mod detect;
 pub mod fixed;
-pub mod foot_frame;
-pub mod fuzzy;
 pub mod gait;
-pub mod low_pass;
-pub mod mean_filter;
-pub mod models;
+pub mod length;
 pub mod mpu6050;
-pub mod peak_valley;
-pub mod phase_stats;
-pub mod phases;
 pub mod pipeline;
-pub mod rate;
-pub mod rest;
-pub mod sample;
-pub mod stance;
-pub mod stride;
-pub mod svr;
-#[rustfmt::skip] // generated by `gaitclip train`, compared byte for byte by a test
-pub mod trained;
-pub mod units;
-pub mod zupt;
+pub mod record;
+pub mod sensor;
+pub mod signal;

@@ -21,7 +21,7 @@
 use embedded_hal::delay::DelayNs;
 use embedded_hal::i2c::I2c;
 
-use crate::sample::{AccelRange, GyroRange, RawSample, SAMPLE_BYTES};
+use crate::sensor::sample::{AccelRange, GyroRange, RawSample, SAMPLE_BYTES};
 
 /// Register addresses (MPU-6000/6050 Register Map, rev. 4.2).
 pub mod reg {

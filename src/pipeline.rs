@@ -12,134 +12,43 @@
 //! windows are undone by delay lines, so that every stride index is the number of the raw
 //! sample it names.
 //!
-//! **Three detectors** behind one seam ([`crate::detector::StepDetector`]; the pipeline is
-//! generic over it): the default [`crate::cycle::CycleDetector`] replaces the stance
+//! **Three detectors** behind one seam ([`crate::detect::seam::StepDetector`]; the pipeline is
+//! generic over it): the default [`crate::detect::cycle::CycleDetector`] replaces the stance
 //! detector and stride tracker above by one zero-velocity instant per gait cycle, strides
 //! from instant to instant, the same phases, ZUPT and models;
-//! [`crate::stride::StanceStrides`] is the chain above (Huang's method);
-//! [`crate::peak_valley::PeakValleySteps`] is Lu's peak-valley detector on the foot frame's
+//! [`crate::detect::stance_strides::StanceStrides`] is the chain above (Huang's method);
+//! [`crate::detect::peak_valley::PeakValleySteps`] is Lu's peak-valley detector on the foot frame's
 //! vertical acceleration, each step measured with Lu's own chain, fuzzy `k` and Weinberg
-//! ([`crate::peak_valley::lu_chain_um`]):
+//! ([`crate::length::lu::lu_chain_um`]):
 //!
 //! ```text
 //! raw sample ─ mean filter ─ rotate into the foot frame ─ vertical ─ peak-valley detector
 //!                                                          step ─→ D, f ─→ fuzzy k ─→ Weinberg
 //! ```
 
-use crate::bridge;
-use crate::cycle::Calibration;
-pub use crate::detector::Detector;
-use crate::detector::{AnyDetector, DelayLines, Drain, Input, StepDetector};
-use crate::estimate::LengthEstimator;
-use crate::foot_frame::FootFrameEstimator;
+pub mod config;
+pub mod detectors;
+
+use crate::detect::cycle::Calibration;
+use crate::detect::foot_frame::FootFrameEstimator;
+use crate::detect::phase_stats::StrideStats;
+use crate::detect::rest::{RestDetector, RestThresholds};
+use crate::detect::seam::{DelayLines, Drain, Input, StepDetector, MAX_MOVEMENT_SAMPLES};
 use crate::gait::GaitTimer;
-use crate::mean_filter::MeanFilter;
-use crate::models::{LengthChain, Model, ModelParams, Settings};
-use crate::phase_stats::StrideStats;
-use crate::phases::PhaseMethod;
-use crate::rate::SampleRate;
-use crate::rest::{RestDetector, RestThresholds};
-use crate::sample::{Rails, RawSample};
-use crate::stance::StanceLimits;
-use crate::stride::{Origin, Stride, MAX_MOVEMENT_SAMPLES, MIN_MOVEMENT_MS};
-use crate::units::{AccelScale, GyroScale};
+use crate::length::estimate::LengthEstimator;
+use crate::length::models::LengthChain;
+use crate::pipeline::config::{Config, FILL_MAX_MS};
+use crate::pipeline::detectors::AnyDetector;
+use crate::record::stride::Stride;
+use crate::sensor::sample::{Origin, Rails, RawSample};
+use crate::signal::bridge;
+use crate::signal::mean_filter::MeanFilter;
 
 /// Capacity of the mean filter; the window used is the power of two nearest
 /// [`MEAN_FILTER_MS`] at the sample rate, at most this.
 pub const MEAN_FILTER_CAPACITY: usize = 16;
 /// Mean-filter window, ms (4 samples at 200 Hz, 16 at 1 kHz).
 pub const MEAN_FILTER_MS: u32 = 20;
-/// Capacity of the delay lines that align raw samples and foot-frame samples with the
-/// (centred) stance decision: ≥ stance delay (63) + filter delay (7) + 1.
-pub const DELAY_CAPACITY: usize = 128;
-
-/// Longest hole of lost samples that is bridged: interpolated across when the next sample
-/// arrives, the stride it falls in flagged [`StrideFlags::BRIDGED`](crate::stride::StrideFlags::BRIDGED) and still measured.
-/// Chosen by measurement (`gaitclip holes`, the README's hole table): the longest hole
-/// whose mean |length error| against the uncut recordings stays ≤ 1 cm at the recordings'
-/// rate and at half of it (with the cycle detector and the ZUPT stride as the default:
-/// 30 ms holes cost 10.6 mm at 100 Hz in clusters in the swing; 30 ms until then).
-pub const BRIDGE_MAX_MS: u32 = 20;
-/// Longest hole interpolated at all. A longer hole than [`BRIDGE_MAX_MS`], up to this, is
-/// filled too so that the stride's events outside it are still found, but a stride whose
-/// movement it falls in is a [`StrideFlags::GAP`](crate::stride::StrideFlags::GAP) stride without a length. Anything longer
-/// restarts detection after it. At most [`MIN_MOVEMENT_MS`]: the samples one call then
-/// feeds are fewer than separate two strides, so one call never has two to report.
-pub const FILL_MAX_MS: u32 = MIN_MOVEMENT_MS;
-const _: () = assert!(BRIDGE_MAX_MS <= FILL_MAX_MS && FILL_MAX_MS <= MIN_MOVEMENT_MS);
-
-/// The model the firmware ships with as its stride length: the one with the best
-/// leave-one-dataset-out score, as `gaitclip train` measured it
-/// ([`crate::trained::LODO_BEST`]; the README's length tables).
-pub const DEFAULT_MODEL: Model = crate::trained::LODO_BEST;
-
-/// What the pipeline needs to know about the data.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub struct Config {
-    /// Sample rate.
-    pub rate: SampleRate,
-    /// Accelerometer scale of the counts (counts per g; the MPU6050's from
-    /// [`crate::sample::AccelRange::scale`]).
-    pub accel: AccelScale,
-    /// Gyroscope scale of the counts (counts per °/s; [`crate::sample::GyroRange::scale`]).
-    pub gyro: GyroScale,
-    /// Where each axis clips, counts ([`Rails::FULL_SCALE`] for the MPU6050; a replayed
-    /// recording's are learnt from its data or given).
-    pub rails: Rails,
-    /// Whether the cycle detector puts back what a clipped accelerometer lost
-    /// ([`crate::clipping`]; true). A setting so that the clipping sweep can measure what
-    /// the restoration does.
-    pub restore_accel: bool,
-    /// Step detector.
-    pub detector: Detector,
-    /// Phase splitter version.
-    pub phases: PhaseMethod,
-    /// The model that fills in [`Stride::length_mm`].
-    pub model: Model,
-    /// Device settings of the models (the wearer's height).
-    pub settings: Settings,
-    /// Trained coefficients and SVRs.
-    pub params: &'static ModelParams<'static>,
-    /// Longest hole bridged, ms ([`BRIDGE_MAX_MS`]; clamped to [`FILL_MAX_MS`]). A setting
-    /// so that the hole-length sweep can measure what each limit costs.
-    pub bridge_max_ms: u32,
-    /// The stance detector's thresholds ([`StanceLimits::DEFAULT`]); a setting for the
-    /// threshold sweep of [`crate::stance`].
-    pub stance: StanceLimits,
-    /// The sensor's height above the foot's rolling contact, µm
-    /// ([`crate::cycle::SENSOR_HEIGHT_UM`]): where the clip sits on the shoe.
-    pub sensor_height_um: u32,
-}
-
-impl Config {
-    /// The default configuration for data at `rate` in the given scales: the cycle
-    /// detector, the augmented phase splitter, the [`DEFAULT_MODEL`] with the shipped
-    /// [`crate::trained::PARAMS`], and the default height.
-    pub const fn new(rate: SampleRate, accel: AccelScale, gyro: GyroScale) -> Self {
-        Config {
-            rate,
-            accel,
-            gyro,
-            rails: Rails::FULL_SCALE,
-            restore_accel: true,
-            detector: Detector::Cycle,
-            phases: PhaseMethod::Augmented,
-            model: DEFAULT_MODEL,
-            settings: Settings::DEFAULT,
-            params: &crate::trained::PARAMS,
-            bridge_max_ms: BRIDGE_MAX_MS,
-            stance: StanceLimits::DEFAULT,
-            sensor_height_um: crate::cycle::SENSOR_HEIGHT_UM,
-        }
-    }
-
-    /// The model behind the strides' lengths: [`Config::model`], unless the detector measures
-    /// with its own chain (Lu's fuzzy Weinberg for the peak-valley detector).
-    pub const fn length_model(&self) -> Model {
-        self.detector.length_model(self.model)
-    }
-}
-
 const fn log2_nearest(n: u32) -> u32 {
     // Largest power of two ≤ n, moved up when n is nearer the next one.
     let mut k = 0;
@@ -156,7 +65,7 @@ const fn log2_nearest(n: u32) -> u32 {
 /// Holes of lost samples the pipeline has met, by what it did with them.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub struct HoleCounts {
-    /// Holes bridged ([`BRIDGE_MAX_MS`] or shorter).
+    /// Holes bridged ([`BRIDGE_MAX_MS`](crate::pipeline::config::BRIDGE_MAX_MS) or shorter).
     pub bridged: u32,
     /// Samples interpolated across them.
     pub bridged_samples: u32,
@@ -187,7 +96,7 @@ impl HoleCounts {
 /// one after the other add up).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum HoleKind {
-    /// Interpolated; the stride keeps its length ([`StrideFlags::BRIDGED`](crate::stride::StrideFlags::BRIDGED)).
+    /// Interpolated; the stride keeps its length ([`StrideFlags::BRIDGED`](crate::record::stride::StrideFlags::BRIDGED)).
     Bridged,
     /// Interpolated for the events; a stride whose movement it falls in is a gap stride.
     Filled,
@@ -255,9 +164,9 @@ impl<const M: usize> Pipeline<AnyDetector<M>> {
     /// A pipeline for data described by `config`, with the detector it names, that keeps
     /// at most `M` samples of a movement (6 bytes each). A board short of RAM picks fewer:
     /// `M` must cover the longest walking movement at its rate (about 1 s), or strides come
-    /// out [`crate::stride::StrideFlags::TOO_LONG`].
+    /// out [`crate::record::stride::StrideFlags::TOO_LONG`].
     pub const fn sized(config: Config) -> Self {
-        Self::with_detector(config, AnyDetector::new(&config))
+        Self::with_detector(config, AnyDetector::new(config.detector, &config.detect()))
     }
 }
 
@@ -278,7 +187,7 @@ impl<D: StepDetector> Pipeline<D> {
             gait: GaitTimer::new(config.rate),
             estimate: LengthEstimator::new(),
             chain: LengthChain {
-                model: config.model,
+                model: config.length_model(),
                 settings: config.settings,
                 params: config.params,
                 rate: config.rate,
@@ -324,12 +233,12 @@ impl<D: StepDetector> Pipeline<D> {
     /// Latency of the detector's decision in samples: the decision about a sample is made
     /// when this many more have been fed. A stride is reported at the decision that closes
     /// it (for the stance detector, when the stance after it ends, or
-    /// [`crate::stride::MAX_STANCE_IN_STRIDE_MS`] into it).
+    /// [`crate::detect::seam::MAX_STANCE_IN_STRIDE_MS`] into it).
     pub fn latency(&self) -> u32 {
         self.detector.delay(self.filter.delay())
     }
 
-    /// Whether the clip is still: the orientation-free rest test ([`crate::rest`]) on the
+    /// Whether the clip is still: the orientation-free rest test ([`crate::detect::rest`]) on the
     /// latest window of samples, false until a window has filled after the start or a
     /// restart. What a board's sleep policy watches.
     pub const fn at_rest(&self) -> bool {
@@ -347,8 +256,8 @@ impl<D: StepDetector> Pipeline<D> {
     }
 
     /// The foot frame found so far, if any: set once the clip has been still for
-    /// [`crate::foot_frame::FIRST_FRAME_AFTER_MS`], its heading learnt from the first steps.
-    pub const fn foot_frame(&self) -> Option<crate::foot_frame::FootFrame> {
+    /// [`crate::detect::foot_frame::FIRST_FRAME_AFTER_MS`], its heading learnt from the first steps.
+    pub const fn foot_frame(&self) -> Option<crate::detect::foot_frame::FootFrame> {
         self.frame.frame()
     }
 
@@ -503,18 +412,18 @@ impl<D: StepDetector> Pipeline<D> {
     /// Declares `missing` samples lost (FIFO overflow, a sensor that stopped answering, a
     /// jump in timestamps). What happens depends on how long the hole is:
     ///
-    /// - **Up to [`BRIDGE_MAX_MS`]: bridged.** Nothing happens until the next sample; then
+    /// - **Up to [`BRIDGE_MAX_MS`](crate::pipeline::config::BRIDGE_MAX_MS): bridged.** Nothing happens until the next sample; then
     ///   the missing samples are interpolated (a cubic through the two samples either side)
     ///   and fed as if measured. The stride they fall in is flagged
-    ///   [`StrideFlags::BRIDGED`](crate::stride::StrideFlags::BRIDGED) and keeps its length and events.
+    ///   [`StrideFlags::BRIDGED`](crate::record::stride::StrideFlags::BRIDGED) and keeps its length and events.
     /// - **Up to [`FILL_MAX_MS`]: filled.** Interpolated on a straight line, so that
     ///   detection goes on and the events outside the hole are found, but a stride whose
-    ///   movement the hole falls in is a [`StrideFlags::GAP`](crate::stride::StrideFlags::GAP) stride, without a length (an
+    ///   movement the hole falls in is a [`StrideFlags::GAP`](crate::record::stride::StrideFlags::GAP) stride, without a length (an
     ///   event found inside the hole is set to its first sample). In a stance, where the
-    ///   foot is at rest either side, it only flags the stride [`StrideFlags::BRIDGED`](crate::stride::StrideFlags::BRIDGED).
+    ///   foot is at rest either side, it only flags the stride [`StrideFlags::BRIDGED`](crate::record::stride::StrideFlags::BRIDGED).
     /// - **Longer: detection restarts.** The detector drains what it can
     ///   ([`StepDetector::restart`]), the stride in progress becomes a
-    ///   [`StrideFlags::GAP`](crate::stride::StrideFlags::GAP) stride (no length; reported once the next stance is found
+    ///   [`StrideFlags::GAP`](crate::record::stride::StrideFlags::GAP) stride (no length; reported once the next stance is found
     ///   after the gap), and detection restarts after it. Returns the stride that was
     ///   complete before the hole, if the detector held one, measured as usual.
     ///
@@ -666,7 +575,8 @@ impl<D: StepDetector> Pipeline<D> {
     /// The stages after the detector: the length (measured, or estimated where it could
     /// not be), then the gait parameters that need it.
     fn complete(&mut self, s: &mut Stride) {
-        self.detector.measure(s, &self.chain);
+        let (stats, step) = (self.detector.stats(s.index), self.detector.step(s.index));
+        self.chain.measure(s, stats, step);
         self.estimate.process(s);
         self.gait.process(s);
     }

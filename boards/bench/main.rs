@@ -10,7 +10,7 @@
 //!
 //! With the `peak-valley-detector` feature the pipeline runs Lu's detector instead: the
 //! sample path then covers its low-pass and rules, and each step's length (Lu's chain) is
-//! counted in `PeakValleySteps::measure_step`; there are no features or models to call.
+//! counted in `gaitclip::length::lu::lu_chain_um`; there are no features or models to call.
 //!
 //! No interrupts run: the counts are the pipeline's own. The board is the QEMU machine of the
 //! target (mps2-an386 for thumbv7em, microbit for thumbv6m), with the movement buffer of the
@@ -28,13 +28,15 @@ use core::hint::black_box;
 use cortex_m_rt::{entry, exception};
 use cortex_m_semihosting::debug;
 use defmt_semihosting as _;
-use gaitclip::features::Features;
-use gaitclip::models::{self, Model, Settings};
-use gaitclip::phase_stats::StrideStats;
-use gaitclip::pipeline::{Config, Detector, Pipeline};
-use gaitclip::rate::SampleRate;
-use gaitclip::sample::{AccelRange, GyroRange, RawSample, SAMPLE_BYTES};
-use gaitclip::stride::Stride;
+use gaitclip::detect::phase_stats::StrideStats;
+use gaitclip::length::features::Features;
+use gaitclip::length::models::{self, Model, Settings};
+use gaitclip::pipeline::config::Config;
+use gaitclip::pipeline::detectors::Detector;
+use gaitclip::pipeline::Pipeline;
+use gaitclip::record::stride::Stride;
+use gaitclip::sensor::rate::SampleRate;
+use gaitclip::sensor::sample::{AccelRange, GyroRange, RawSample, SAMPLE_BYTES};
 use gaitclip_board::Steps;
 use static_cell::ConstStaticCell;
 
@@ -43,7 +45,7 @@ use static_cell::ConstStaticCell;
 const MOVEMENT_SAMPLES: usize = 256;
 #[cfg(not(armv6m))]
 const MOVEMENT_SAMPLES: usize =
-    gaitclip::stride::movement_samples(trace::RATE_MILLIHERTZ.div_ceil(1000));
+    gaitclip::detect::seam::movement_samples(trace::RATE_MILLIHERTZ.div_ceil(1000));
 
 const fn unwrap<T: Copy>(v: Option<T>) -> T {
     match v {
@@ -66,8 +68,10 @@ const CONFIG: Config = {
 /// The pipeline with the firmware's detector (the cycle detector, or Lu's with the
 /// `peak-valley-detector` feature), as the board ships it.
 type BenchPipeline = Pipeline<Steps<MOVEMENT_SAMPLES>>;
-static PIPELINE: ConstStaticCell<BenchPipeline> =
-    ConstStaticCell::new(Pipeline::with_detector(CONFIG, Steps::new(&CONFIG)));
+static PIPELINE: ConstStaticCell<BenchPipeline> = ConstStaticCell::new(Pipeline::with_detector(
+    CONFIG,
+    Steps::new(&CONFIG.detect()),
+));
 
 /// What the benchmark found: strides and their summed length.
 #[derive(Default)]

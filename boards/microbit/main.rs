@@ -32,7 +32,7 @@ const MOVEMENT_SAMPLES: usize = 256;
 /// (moving 8–12 KiB through the stack is more than a 16 KiB part can spare), and the stack
 /// holds only what one sample's processing needs.
 static PIPELINE: ConstStaticCell<Pipeline<Steps<MOVEMENT_SAMPLES>>> = ConstStaticCell::new(
-    Pipeline::with_detector(replay_app::CONFIG, Steps::new(&replay_app::CONFIG)),
+    Pipeline::with_detector(replay_app::CONFIG, Steps::new(&replay_app::CONFIG.detect())),
 );
 
 #[entry]

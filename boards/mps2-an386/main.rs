@@ -28,7 +28,7 @@ const CYCLES_PER_US: u32 = 25;
 static PIPELINE: ConstStaticCell<Pipeline<Steps<{ replay_app::MOVEMENT_SAMPLES }>>> =
     ConstStaticCell::new(Pipeline::with_detector(
         replay_app::CONFIG,
-        Steps::new(&replay_app::CONFIG),
+        Steps::new(&replay_app::CONFIG.detect()),
     ));
 
 #[entry]

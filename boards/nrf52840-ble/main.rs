@@ -86,8 +86,9 @@ bind_interrupts!(struct Irqs {
 /// The sampler's executor, on a software interrupt above thread mode.
 static SAMPLER_EXECUTOR: InterruptExecutor = InterruptExecutor::new();
 static QUEUE: ConstStaticCell<Queue<Item, QUEUE_LEN>> = ConstStaticCell::new(Queue::new());
-static PIPELINE: ConstStaticCell<Pipeline<Steps<MOVEMENT_SAMPLES>>> =
-    ConstStaticCell::new(Pipeline::with_detector(CONFIG, Steps::new(&CONFIG)));
+static PIPELINE: ConstStaticCell<Pipeline<Steps<MOVEMENT_SAMPLES>>> = ConstStaticCell::new(
+    Pipeline::with_detector(CONFIG, Steps::new(&CONFIG.detect())),
+);
 /// Raised by the sampler after every data-ready pulse it handled.
 static QUEUED: Signal<CriticalSectionRawMutex, ()> = Signal::new();
 /// The pipeline task's sleep request for the sampler: the sample count to sleep after.

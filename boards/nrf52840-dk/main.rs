@@ -117,8 +117,9 @@ type WatchdogTimer = Timer<TIMER1, Periodic>;
 static WATCHDOG: Mutex<RefCell<Option<(WatchdogTimer, Watchdog)>>> = Mutex::new(RefCell::new(None));
 static QUEUE: ConstStaticCell<Queue<Item, QUEUE_LEN>> = ConstStaticCell::new(Queue::new());
 /// The pipeline's configuration.
-static PIPELINE: ConstStaticCell<Pipeline<Steps<MOVEMENT_SAMPLES>>> =
-    ConstStaticCell::new(Pipeline::with_detector(CONFIG, Steps::new(&CONFIG)));
+static PIPELINE: ConstStaticCell<Pipeline<Steps<MOVEMENT_SAMPLES>>> = ConstStaticCell::new(
+    Pipeline::with_detector(CONFIG, Steps::new(&CONFIG.detect())),
+);
 
 #[entry]
 fn main() -> ! {

@@ -126,8 +126,9 @@ static SLEEP_CLOCK: Mutex<RefCell<Option<(Timer, u64)>>> = Mutex::new(RefCell::n
 const SETTLE: u32 = SleepPolicy::settle_samples(RATE, &SLEEP);
 static QUEUE: ConstStaticCell<Queue<Item, QUEUE_LEN>> = ConstStaticCell::new(Queue::new());
 /// The pipeline's configuration.
-static PIPELINE: ConstStaticCell<Pipeline<Steps<MOVEMENT_SAMPLES>>> =
-    ConstStaticCell::new(Pipeline::with_detector(CONFIG, Steps::new(&CONFIG)));
+static PIPELINE: ConstStaticCell<Pipeline<Steps<MOVEMENT_SAMPLES>>> = ConstStaticCell::new(
+    Pipeline::with_detector(CONFIG, Steps::new(&CONFIG.detect())),
+);
 
 #[hal::entry]
 fn main() -> ! {

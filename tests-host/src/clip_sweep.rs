@@ -1,5 +1,5 @@
 //! `gaitclip clipping`: what a clipped accelerometer costs a stride, and what putting its loss
-//! back ([`gaitclip::clipping`]) recovers, measured on real recordings clipped on purpose.
+//! back ([`gaitclip::detect::clipping`]) recovers, measured on real recordings clipped on purpose.
 //!
 //! `gaitmap_walk` and `pyshoe_vicon` are replayed as recorded (±16 g: their sensors barely
 //! reach it) and again clipped: converted at the MPU6050's ±8 g and ±4 g ranges (the counts
@@ -11,15 +11,15 @@
 //! instant takes from one stride it gives the next) has its ZUPT length compared with that
 //! stride's: with the
 //! loss left in (`Config::restore_accel` false) and put back, and against what the estimate
-//! from the strides before it ([`gaitclip::estimate`]) would have said: on every row putting
+//! from the strides before it ([`gaitclip::length::estimate`]) would have said: on every row putting
 //! the loss back is far nearer, so a clipped stride is always measured, never estimated. By
 //! how many samples clipped and where in the
 //! stride (push-off: heel-off to toe-off; swing; heel strike: heel-strike to the stance
 //! instant that ends the stride).
 
 use anyhow::Result;
-use gaitclip::sample::{AccelRange, GyroRange, Rails, RawSample};
-use gaitclip::stride::{Stride, StrideFlags};
+use gaitclip::record::stride::{Stride, StrideFlags};
+use gaitclip::sensor::sample::{AccelRange, GyroRange, Rails, RawSample};
 
 use crate::datasets;
 use crate::markdown::{cm_cell, Table};
@@ -163,7 +163,7 @@ pub fn sweep(dataset: &datasets::Dataset, clipping: &Clipping) -> Result<SweepRe
         let p = replay::prepare(&ct, clipping.ranges)?;
         let config = p.config(clipping.ranges);
         let restored = p.strides(config);
-        let left = p.strides(gaitclip::pipeline::Config {
+        let left = p.strides(gaitclip::pipeline::config::Config {
             restore_accel: false,
             ..config
         });
@@ -176,7 +176,7 @@ pub fn sweep(dataset: &datasets::Dataset, clipping: &Clipping) -> Result<SweepRe
             .map(|(i, _)| p.clock.number_of_row(i))
             .collect();
         out.clipped_samples += clipped_at.len();
-        let mut estimator = gaitclip::estimate::LengthEstimator::new();
+        let mut estimator = gaitclip::length::estimate::LengthEstimator::new();
         for (s, l) in restored.iter().zip(&left) {
             let est = estimator.estimate_mm();
             estimator.process(&mut s.clone());

@@ -1,13 +1,14 @@
-//! The generated Rust source the firmware compiles (`src/trained.rs`): every model's
+//! The generated Rust source the firmware compiles (`src/length/trained.rs`): every model's
 //! coefficients and SVR tables, the models the pipeline does not ship behind `all-models`.
 
 use std::fmt::Write as _;
 
-use gaitclip::features::{self};
-use gaitclip::models::Model;
+use gaitclip::length::features::{self};
+use gaitclip::length::models::Model;
 
 use crate::fit::{terms, SvrQ, SLOTS};
-use crate::train::{Training, TRAINING_DATASETS};
+use crate::train::Training;
+use crate::training_set::TRAINING_DATASETS;
 
 /// `#[cfg]` line of the tables of a model that only builds with the `all-models` feature
 /// (every SVR model but the pipeline's default), or nothing.
@@ -75,7 +76,7 @@ fn svr_source(out: &mut String, gate: &str, name: &str, s: &SvrQ) -> String {
     )
 }
 
-/// The Rust source of `src/trained.rs` for `t`.
+/// The Rust source of `src/length/trained.rs` for `t`.
 pub fn rust_source(t: &Training) -> String {
     let tr = &t.trained;
     let mut body = String::new();
@@ -168,10 +169,10 @@ pub fn rust_source(t: &Training) -> String {
     for (m, r) in &ranked {
         let _ = writeln!(s, "//! | `{}` | {:.2} |", m.name(), r * 100.0);
     }
-    s.push_str("\nuse crate::models::{Model, ModelParams};\nuse crate::svr::{Boosted, Svr};\n\n");
+    s.push_str("\nuse crate::length::models::{Model, ModelParams};\nuse crate::length::svr::{Boosted, Svr};\n\n");
     let _ = writeln!(
         s,
-        "/// The model with the best leave-one-dataset-out score: the pipeline's default\n/// ([`crate::pipeline::DEFAULT_MODEL`]).\npub const LODO_BEST: Model = Model::{:?};\n",
+        "/// The model with the best leave-one-dataset-out score: the pipeline's default\n/// ([`crate::pipeline::config::DEFAULT_MODEL`]).\npub const LODO_BEST: Model = Model::{:?};\n",
         t.default_model
     );
     s.push_str("/// The SVR hyper-parameters `[C, γ, ε (m)]` chosen by cross-validation, for push-off,\n/// swing, heel-strike and the whole movement: `gaitclip eval` re-fits each fold with them.\npub const HYPER: [[f64; 3]; 4] = [\n");

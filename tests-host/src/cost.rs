@@ -17,7 +17,7 @@ use std::fmt::Write as _;
 use anyhow::{ensure, Context, Result};
 use object::{Object, ObjectSection, SectionFlags};
 
-use gaitclip::pipeline::Detector;
+use gaitclip::pipeline::detectors::Detector;
 
 use crate::firmware::build_for;
 use crate::insn_count::{run_bench, run_bench_peak_valley, InsnReport, Stat, StepInsnReport};
@@ -205,7 +205,7 @@ pub fn report(inp: &Inputs) -> Result<String> {
     )?;
     let module = inp.scratch.join(format!("{name}.rs"));
     let env = [("GAITCLIP_BENCH_TRACE", module.as_os_str())];
-    let config = gaitclip::pipeline::Config::new(
+    let config = gaitclip::pipeline::config::Config::new(
         trace.sample_rate().context("trace rate")?,
         ranges.accel.scale(),
         ranges.gyro.scale(),
@@ -439,7 +439,7 @@ fn render(r: &Report) -> String {
     );
     let _ = writeln!(
         o,
-        "| per step: Lu's chain (`PeakValleySteps::measure_step`) | {} | {} |",
+        "| per step: Lu's chain (`lu::lu_chain_um`) | {} | {} |",
         f(&l4.step),
         f(&l0.step)
     );

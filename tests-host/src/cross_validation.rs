@@ -4,7 +4,7 @@
 use std::collections::BTreeMap;
 
 use anyhow::Result;
-use gaitclip::phase_stats::Segment;
+use gaitclip::detect::phase_stats::Segment;
 
 use crate::fit::{fit_svr, select, Hyper, HyperSet, Sample, SLOTS};
 

@@ -120,7 +120,7 @@ pub fn read(path: &Path, rate_hz: Option<f64>) -> Result<Trace, CsvError> {
 
 /// The nominal ranges `acc_range_g` and `gyro_range_dps` of a `meta.json` beside the file,
 /// where it gives them.
-fn meta_ranges(csv: &Path) -> Result<crate::rails::GivenRanges, CsvError> {
+fn meta_ranges(csv: &Path) -> Result<crate::trace::GivenRanges, CsvError> {
     let meta = csv.with_file_name("meta.json");
     let Ok(text) = fs::read_to_string(&meta) else {
         return Ok(Default::default());
@@ -140,7 +140,7 @@ fn meta_ranges(csv: &Path) -> Result<crate::rails::GivenRanges, CsvError> {
                 message: format!("{name} is not a positive number: {r}"),
             }),
     };
-    Ok(crate::rails::GivenRanges {
+    Ok(crate::trace::GivenRanges {
         acc_g: field("acc_range_g")?,
         gyro_dps: field("gyro_range_dps")?,
     })

@@ -1,4 +1,4 @@
-//! `f64` twin of the cycle detector's stride ([`gaitclip::cycle`]): every stride the core
+//! `f64` twin of the cycle detector's stride ([`gaitclip::detect::cycle`]): every stride the core
 //! reports, measured again in floating point from the same raw samples, the same stance
 //! instants and the same calibration, so that the fixed-point arithmetic (levelling, the
 //! rolling contact, the strapdown integration, dedrift, the rail reconstruction and the
@@ -10,11 +10,12 @@
 //! detector's energy, whose arithmetic [`energy`] checks against the same formula in `f64`
 //! (`tests/fixed_point.rs`).
 
-use gaitclip::clipping::SHAPED_RUN_MIN;
-use gaitclip::cycle::{Calibration, CycleConfig, SIGMA_A_MMPS2, SIGMA_W_MRADPS};
-use gaitclip::pipeline::{Config, Pipeline};
-use gaitclip::sample::{AxisRails, RawSample};
-use gaitclip::stride::{Stride, StrideFlags};
+use gaitclip::detect::clipping::SHAPED_RUN_MIN;
+use gaitclip::detect::cycle::{Calibration, CycleConfig, SIGMA_A_MMPS2, SIGMA_W_MRADPS};
+use gaitclip::pipeline::config::Config;
+use gaitclip::pipeline::Pipeline;
+use gaitclip::record::stride::{Stride, StrideFlags};
+use gaitclip::sensor::sample::{AxisRails, RawSample};
 use nalgebra::{UnitQuaternion, Vector3};
 
 use crate::clock::Gap;
@@ -272,7 +273,7 @@ pub fn zupt_m(run: &CoreRun, k: usize) -> Result<f64, Skipped> {
     Ok(p.xy().norm())
 }
 
-/// [`gaitclip::clipping::RailRun`] in `f64`: the parabola's area above the rail per clipped
+/// [`gaitclip::detect::clipping::RailRun`] in `f64`: the parabola's area above the rail per clipped
 /// run, counts·samples.
 #[derive(Clone, Copy, Debug, Default)]
 struct RailRunF64 {

@@ -8,6 +8,11 @@
 //! <!-- end generated -->
 //! ```
 //!
+//! A marker names either one of the in-process reports ([`GENERATORS`]) or a whole command
+//! line of the `gaitclip` binary (one of [`COMMANDS`], e.g. `<!-- generated: gaitclip eval
+//! gaitmap_walk pyshoe_vicon -->`), whose words that name a dataset folder are read as that
+//! folder under the datasets root; the block is what the command prints on stdout.
+//!
 //! `gaitclip docs` runs every marked command on `../shared/datasets` and writes its output
 //! between the markers; `gaitclip docs --check` writes nothing and fails naming every block
 //! whose text differs, which `tests/docs_current.rs` runs in the test command. Re-measuring
@@ -28,6 +33,10 @@ pub const GENERATORS: &[(&str, Generator)] = &[
     ("running", crate::running::report),
     ("flags", crate::flag_costs::report),
 ];
+
+/// The subcommands of the `gaitclip` binary a marker may run as a whole command line: the
+/// ones that print deterministic Markdown (no time, no machine figure).
+pub const COMMANDS: &[&str] = &["eval", "gait", "holes", "wake", "zupt-sweep", "energy"];
 
 const OPEN: &str = "<!-- generated: gaitclip ";
 const CLOSE: &str = "<!-- end generated -->";
@@ -86,8 +95,9 @@ pub fn regenerate_text(
     Ok((out, stale))
 }
 
-/// Every page of `docs` (`*.md`) regenerated from the datasets under `datasets`.
-pub fn regenerate(docs: &Path, datasets: &Path) -> Result<Vec<Page>> {
+/// Every page of `docs` (`*.md`) regenerated from the datasets under `datasets`; `exe` is
+/// the `gaitclip` binary that runs the command-line blocks.
+pub fn regenerate(docs: &Path, datasets: &Path, exe: &Path) -> Result<Vec<Page>> {
     let mut paths: Vec<PathBuf> = std::fs::read_dir(docs)
         .with_context(|| format!("{}", docs.display()))?
         .filter_map(|e| e.ok().map(|e| e.path()))
@@ -102,16 +112,55 @@ pub fn regenerate(docs: &Path, datasets: &Path) -> Result<Vec<Page>> {
             if let Some((_, out)) = cache.iter().find(|(n, _)| n == name) {
                 return Ok(out.clone());
             }
-            let Some((_, f)) = GENERATORS.iter().find(|(n, _)| *n == name) else {
-                bail!("no generator `{name}` (known: {:?})", names());
-            };
-            let out = f(datasets)?;
+            let out = block(name, datasets, exe)?;
             cache.push((name.to_string(), out.clone()));
             Ok(out)
         })?;
         pages.push(Page { path, text, stale });
     }
     Ok(pages)
+}
+
+/// What the marker `name` prints.
+fn block(name: &str, datasets: &Path, exe: &Path) -> Result<String> {
+    if let Some((_, f)) = GENERATORS.iter().find(|(n, _)| *n == name) {
+        return f(datasets);
+    }
+    let words = command_line(name, datasets)?;
+    let out = std::process::Command::new(exe)
+        .args(&words)
+        .output()
+        .with_context(|| format!("running {}", exe.display()))?;
+    if !out.status.success() {
+        bail!(
+            "`gaitclip {name}` failed ({}): {}",
+            out.status,
+            String::from_utf8_lossy(&out.stderr).trim()
+        );
+    }
+    String::from_utf8(out.stdout).context("the command printed non-UTF-8")
+}
+
+/// The arguments of the command-line marker `name`, datasets resolved under `datasets`.
+pub fn command_line(name: &str, datasets: &Path) -> Result<Vec<String>> {
+    let words: Vec<&str> = name.split_whitespace().collect();
+    let Some(cmd) = words.first().filter(|c| COMMANDS.contains(c)) else {
+        bail!(
+            "no generator `{name}` (known: {:?}, or a command line of {:?})",
+            names(),
+            COMMANDS
+        );
+    };
+    let mut out = vec![cmd.to_string()];
+    for w in &words[1..] {
+        let folder = datasets.join(w);
+        if !w.starts_with('-') && folder.is_dir() {
+            out.push(folder.display().to_string());
+        } else {
+            out.push(w.to_string());
+        }
+    }
+    Ok(out)
 }
 
 /// The generator names.
@@ -127,6 +176,23 @@ pub fn docs_dir() -> PathBuf {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn a_command_line_marker_names_datasets_by_folder() {
+        let root = std::env::temp_dir().join("gaitclip-docs-test");
+        std::fs::create_dir_all(root.join("walk")).unwrap();
+        assert_eq!(
+            command_line("eval walk --rotate 2", &root).unwrap(),
+            vec![
+                "eval".to_string(),
+                root.join("walk").display().to_string(),
+                "--rotate".into(),
+                "2".into()
+            ]
+        );
+        assert!(command_line("replay walk", &root).is_err());
+        assert!(command_line("", &root).is_err());
+    }
 
     #[test]
     fn a_block_is_replaced_and_reported_stale_only_when_it_differs() {

@@ -101,7 +101,7 @@ pub type Detector<'a> = &'a dyn Fn(&Trace, Ranges) -> Result<Detections>;
 /// trace is prepared ([`crate::replay::prepare`]: counts, recovered clock, holes) and its
 /// strides reported in sample numbers.
 pub fn core_detector(
-    setup: impl Fn(&mut gaitclip::pipeline::Config),
+    setup: impl Fn(&mut gaitclip::pipeline::config::Config),
 ) -> impl Fn(&Trace, Ranges) -> Result<Detections> {
     move |t: &Trace, r: Ranges| {
         let prepared = crate::replay::prepare(t, r)?;

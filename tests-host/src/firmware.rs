@@ -65,10 +65,10 @@ pub fn build_for(
     dir: &str,
     bin: &str,
     target: &str,
-    detector: gaitclip::pipeline::Detector,
+    detector: gaitclip::pipeline::detectors::Detector,
     env: &[(&str, &std::ffi::OsStr)],
 ) -> anyhow::Result<PathBuf> {
-    use gaitclip::pipeline::Detector;
+    use gaitclip::pipeline::detectors::Detector;
     match detector {
         // The firmware's default detector.
         Detector::Cycle => build_with(dir, bin, target, &[], env),
@@ -108,7 +108,7 @@ pub struct LoggedStride {
 
 impl LoggedStride {
     /// What the firmware logs of a stride.
-    pub fn of(s: &gaitclip::stride::Stride) -> Self {
+    pub fn of(s: &gaitclip::record::stride::Stride) -> Self {
         let g = &s.gait;
         LoggedStride {
             index: s.index,

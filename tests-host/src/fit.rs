@@ -6,10 +6,10 @@
 //! to the firmware's fixed point.
 
 use anyhow::{bail, Context, Result};
-use gaitclip::features::{self, COUNT, PER_SEGMENT, ZUPT_LENGTH};
-use gaitclip::models::{Model, ModelParams, Settings, LINEAR_MODELS, MAX_TERMS};
-use gaitclip::phase_stats::{Channel, Segment};
-use gaitclip::svr::{Boosted, Svr};
+use gaitclip::detect::phase_stats::{Channel, Segment};
+use gaitclip::length::features::{self, COUNT, PER_SEGMENT, ZUPT_LENGTH};
+use gaitclip::length::models::{Model, ModelParams, Settings, LINEAR_MODELS, MAX_TERMS};
+use gaitclip::length::svr::{Boosted, Svr};
 use linfa::prelude::*;
 use linfa_svm::Svm;
 use nalgebra::{DMatrix, DVector};
@@ -53,7 +53,7 @@ pub struct Hyper {
 /// Hyper-parameters of the four SVR slots: push-off, swing, heel-strike, whole movement.
 pub type HyperSet = [Hyper; 4];
 
-/// The hyper-parameters recorded in a generated model (`gaitclip::trained::HYPER`).
+/// The hyper-parameters recorded in a generated model (`gaitclip::length::trained::HYPER`).
 pub fn hyper_from(v: &[[f64; 3]; 4]) -> HyperSet {
     v.map(|[c, gamma, eps]| Hyper { c, gamma, eps })
 }

@@ -14,15 +14,15 @@ use crate::trace::Ranges;
 pub const FIRMWARE_TRACE: &str = "demo_walk";
 
 /// The committed register dump the emulated board replays, decoded to counts.
-pub fn firmware_trace_counts() -> std::io::Result<Vec<gaitclip::sample::RawSample>> {
+pub fn firmware_trace_counts() -> std::io::Result<Vec<gaitclip::sensor::sample::RawSample>> {
     let path = Path::new(env!("CARGO_MANIFEST_DIR"))
         .join("../fixtures")
         .join(format!("{FIRMWARE_TRACE}.mpu6050"));
     let bytes = fs::read(path)?;
     Ok(bytes
-        .chunks_exact(gaitclip::sample::SAMPLE_BYTES)
+        .chunks_exact(gaitclip::sensor::sample::SAMPLE_BYTES)
         .filter_map(|c| c.try_into().ok())
-        .map(|c| gaitclip::sample::RawSample::from_be_bytes(&c))
+        .map(|c| gaitclip::sensor::sample::RawSample::from_be_bytes(&c))
         .collect())
 }
 
@@ -99,7 +99,7 @@ pub fn write_trace_module(
     doc: &str,
     rate_hz: f64,
     ranges: Ranges,
-    counts: &[gaitclip::sample::RawSample],
+    counts: &[gaitclip::sensor::sample::RawSample],
 ) -> anyhow::Result<()> {
     let path = |ext: &str| dir.join(format!("{name}.{ext}"));
     let bytes: Vec<u8> = counts.iter().flat_map(|c| c.to_be_bytes()).collect();

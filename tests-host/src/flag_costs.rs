@@ -14,9 +14,9 @@
 //! measured gait cycle from the ones before it, on all datasets with strides.
 
 use anyhow::Result;
-use gaitclip::pipeline::BRIDGE_MAX_MS;
-use gaitclip::sample::{AccelRange, GyroRange};
-use gaitclip::stride::{Stride, StrideFlags};
+use gaitclip::pipeline::config::BRIDGE_MAX_MS;
+use gaitclip::record::stride::{Stride, StrideFlags};
+use gaitclip::sensor::sample::{AccelRange, GyroRange};
 
 use crate::clip_sweep::{self, Clipping};
 use crate::datasets;
@@ -140,16 +140,16 @@ fn flag_list(bits: u16) -> String {
     }
 }
 
-/// The estimate ([`gaitclip::estimate`]) as a predictor of every measured gait cycle from the
+/// The estimate ([`gaitclip::length::estimate`]) as a predictor of every measured gait cycle from the
 /// ones before it: predicted − measured, m.
 fn predictor(strides: &[Stride]) -> Vec<f64> {
-    let mut est = gaitclip::estimate::LengthEstimator::new();
+    let mut est = gaitclip::length::estimate::LengthEstimator::new();
     let mut e = Vec::new();
     let not_a_cycle = StrideFlags::FROM_REST | StrideFlags::TO_REST | StrideFlags::GAP;
     for s in strides {
         if s.index == 0 {
             // A new trial: nothing carries over.
-            est = gaitclip::estimate::LengthEstimator::new();
+            est = gaitclip::length::estimate::LengthEstimator::new();
         }
         if s.flags.valid() && !s.flags.has(not_a_cycle) {
             if let Some(p) = est.estimate_mm() {

@@ -4,11 +4,13 @@
 
 use std::path::Path;
 
-use gaitclip::models::Model;
-use gaitclip::pipeline::{Config, Detector, Pipeline};
-use gaitclip::rate::SampleRate;
-use gaitclip::sample::{AccelRange, GyroRange, RawSample};
-use gaitclip::stride::{StrideFlags, MAX_STRIDE_MM};
+use gaitclip::length::models::Model;
+use gaitclip::pipeline::config::Config;
+use gaitclip::pipeline::detectors::Detector;
+use gaitclip::pipeline::Pipeline;
+use gaitclip::record::stride::{StrideFlags, MAX_STRIDE_MM};
+use gaitclip::sensor::rate::SampleRate;
+use gaitclip::sensor::sample::{AccelRange, GyroRange, RawSample};
 
 use crate::replay::{replay, StrideReport};
 use crate::trace::{Ranges, Trace};

@@ -26,8 +26,8 @@ use std::collections::BTreeMap;
 use std::fmt::Write as _;
 
 use anyhow::Result;
-use gaitclip::gait::Gait;
-use gaitclip::stride::Stride;
+use gaitclip::record::gait::Gait;
+use gaitclip::record::stride::Stride;
 
 use crate::csv_trace;
 use crate::datasets::{Dataset, Trial};
@@ -177,7 +177,7 @@ fn compare_trial(
                 g.cadence_spm as f64,
                 120_000.0 / stride_ref,
             );
-            if !s.flags.has(gaitclip::stride::StrideFlags::TURN) {
+            if !s.flags.has(gaitclip::record::stride::StrideFlags::TURN) {
                 push(
                     "turning_angle (straight)",
                     "°",

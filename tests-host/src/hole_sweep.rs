@@ -1,5 +1,5 @@
 //! `gaitclip holes`: what a hole of lost samples costs a bridged stride, by hole length, so
-//! that the bridge limit ([`gaitclip::pipeline::BRIDGE_MAX_MS`]) is chosen by measurement.
+//! that the bridge limit ([`gaitclip::pipeline::config::BRIDGE_MAX_MS`]) is chosen by measurement.
 //!
 //! **Method.** Each trial of `gaitmap_walk` and `pyshoe_vicon` is replayed uncut. Its
 //! *walking strides* are the core's valid strides matched to a clean reference stride, not
@@ -13,7 +13,7 @@
 //!
 //! Every other walking stride gets a hole in one replay and the rest in a second, so that no
 //! stride's neighbour is cut. The cut trace is replayed with every hole bridged (the limit
-//! set to [`gaitclip::pipeline::FILL_MAX_MS`]), and each cut stride is compared with the same
+//! set to [`gaitclip::pipeline::config::FILL_MAX_MS`]), and each cut stride is compared with the same
 //! stride uncut: |length difference| of the default model and of the ZUPT displacement, and
 //! |toe-off| and |heel-strike| differences. A cut stride that is no longer found (or is
 //! split) counts as lost. The same sweep runs again on the recordings decimated to half
@@ -29,9 +29,9 @@ use std::fmt::Write as _;
 use std::path::Path;
 
 use anyhow::{Context, Result};
-use gaitclip::pipeline::{Config, FILL_MAX_MS};
-use gaitclip::sample::RawSample;
-use gaitclip::stride::{Stride, StrideFlags};
+use gaitclip::pipeline::config::{Config, FILL_MAX_MS};
+use gaitclip::record::stride::{Stride, StrideFlags};
+use gaitclip::sensor::sample::RawSample;
 
 use crate::clock::Gap;
 use crate::datasets;
@@ -151,7 +151,7 @@ fn walk(dataset: &str, trial: &datasets::Trial, t: &Trace, decimate: usize) -> R
     // Decimated: every `decimate`-th sample at the rate divided by it; references follow.
     let counts: Vec<RawSample> = prepared.counts.iter().step_by(decimate).copied().collect();
     let mhz = prepared.rate.millihertz() / decimate as u32;
-    let rate = gaitclip::rate::SampleRate::from_millihertz(mhz)
+    let rate = gaitclip::sensor::rate::SampleRate::from_millihertz(mhz)
         .with_context(|| format!("{}: rate {mhz} mHz", trial.csv.display()))?;
     let mut config = Config::new(rate, ranges.accel.scale(), ranges.gyro.scale());
     config.bridge_max_ms = FILL_MAX_MS;

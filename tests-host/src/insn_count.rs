@@ -19,20 +19,20 @@ pub const MEASURED: [(&str, &str); 7] = [
     ("sample", "bench::bench_sample"),
     ("features", "bench::bench_features"),
     ("model", "bench::bench_model"),
-    ("close", "gaitclip::cycle::CycleDetector<_>::close"),
-    ("measure", "gaitclip::models::LengthChain::measure"),
-    ("split", "gaitclip::phases::split"),
-    ("stats", "gaitclip::phase_stats::StrideStats::measure"),
+    ("close", "gaitclip::detect::cycle::CycleDetector<_>::close"),
+    ("measure", "gaitclip::length::models::LengthChain::measure"),
+    ("split", "gaitclip::detect::phases::split"),
+    (
+        "stats",
+        "gaitclip::detect::phase_stats::StrideStats::measure",
+    ),
 ];
 
 /// The functions counted in the benchmark built with `peak-valley-detector` (Lu's
 /// detector): the sample path, and Lu's chain on each step, out of line in every build.
 pub const MEASURED_PEAK_VALLEY: [(&str, &str); 2] = [
     ("sample", "bench::bench_sample"),
-    (
-        "step",
-        "gaitclip::peak_valley::PeakValleySteps::measure_step",
-    ),
+    ("step", "gaitclip::length::lu::lu_chain_um"),
 ];
 
 /// Instructions of each call of one function, in the order the calls returned.
@@ -162,11 +162,11 @@ pub struct StepInsnReport {
     /// Their summed length, mm.
     pub distance_mm: u64,
     /// The sample path: `Pipeline::process` with the low-pass and Lu's rules, without
-    /// `PeakValleySteps::measure_step`.
+    /// `lu::lu_chain_um`.
     pub sample: Stat,
     /// Everything per sample, the steps' chain spread over the samples (mean only).
     pub sample_all_mean: f64,
-    /// `PeakValleySteps::measure_step`: Lu's chain (D, f, fuzzy K, Weinberg) on one step.
+    /// `lu::lu_chain_um`: Lu's chain (D, f, fuzzy K, Weinberg) on one step.
     pub step: Stat,
 }
 
@@ -326,7 +326,7 @@ pub fn run_bench_peak_valley(
     );
     ensure!(
         step.inclusive.len() == steps as usize,
-        "{machine}: measure_step counted {} times for {steps} steps",
+        "{machine}: lu_chain_um counted {} times for {steps} steps",
         step.inclusive.len()
     );
     Ok(StepInsnReport {

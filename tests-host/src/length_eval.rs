@@ -29,13 +29,13 @@ use std::collections::BTreeMap;
 use std::fmt::Write as _;
 
 use anyhow::Result;
-use gaitclip::models::{self, Model, ModelParams, MODELS};
+use gaitclip::length::models::{self, Model, ModelParams, MODELS};
 
 use crate::cross_validation;
 use crate::fit::{self, HyperSet, Sample, Trained};
 use crate::plot::{Plot, COLOURS};
 use crate::stats::median;
-use crate::train::{self, TrialRun, TRAINING_DATASETS};
+use crate::training_set::{self, TrialRun, TRAINING_DATASETS};
 
 /// Predictions of every model for every stride of every run: `[run][stride][model]`, m.
 pub type Predictions = Vec<Vec<[f64; MODELS]>>;
@@ -56,7 +56,7 @@ fn predict_run(run: &TrialRun, params: &ModelParams) -> Vec<[f64; MODELS]> {
 
 /// Cross-validated fixed-point predictions for `runs`, and the fit on all training strides.
 pub fn cross_validate(runs: &[TrialRun], hyper: &HyperSet) -> Result<(Predictions, Trained)> {
-    let samples = train::samples(runs);
+    let samples = training_set::samples(runs);
     let fold = cross_validation::folds(samples.iter().map(|s| s.group.clone()));
     let fits: Vec<Result<Trained>> = std::thread::scope(|sc| {
         let handles: Vec<_> = (0..cross_validation::FOLDS)
@@ -129,7 +129,7 @@ pub fn predictions(runs: &[TrialRun], hyper: &HyperSet, v: Validation) -> Result
     match v {
         Validation::KFold => Ok(cross_validate(runs, hyper)?.0),
         Validation::InSample => {
-            let samples = train::samples(runs);
+            let samples = training_set::samples(runs);
             let all: Vec<&Sample> = samples.iter().collect();
             let full = fit::fit_all(&all, hyper)?;
             Ok(runs
@@ -138,7 +138,7 @@ pub fn predictions(runs: &[TrialRun], hyper: &HyperSet, v: Validation) -> Result
                 .collect())
         }
         Validation::LeaveOneDatasetOut => {
-            let samples = train::samples(runs);
+            let samples = training_set::samples(runs);
             let all: Vec<&Sample> = samples.iter().collect();
             let full = fit::fit_all(&all, hyper)?;
             let mut fits: BTreeMap<&str, Trained> = BTreeMap::new();

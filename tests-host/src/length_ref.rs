@@ -1,17 +1,17 @@
-//! f64 reference of the length stage: the features of [`gaitclip::features`], the basis
-//! terms of [`gaitclip::models`], Lu's fuzzy `k` with a fine centre of gravity, and the
+//! f64 reference of the length stage: the features of [`gaitclip::length::features`], the basis
+//! terms of [`gaitclip::length::models`], Lu's fuzzy `k` with a fine centre of gravity, and the
 //! RBF SVR as trained. The fixed-point code is checked against these, and the models are
 //! trained on these features.
 
-use gaitclip::features::{self, Stat, COUNT, STATS, STRIDE_FREQUENCY, ZUPT_LENGTH};
-use gaitclip::foot_frame::FOOT_LSB_PER_G;
-use gaitclip::fuzzy::RULES;
-use gaitclip::models::{Model, Settings, MAX_TERMS};
-use gaitclip::phase_stats::{Channel, ChannelStats, Segment, StrideStats};
-use gaitclip::rate::SampleRate;
-use gaitclip::stride::Stride;
+use gaitclip::detect::phase_stats::{Channel, ChannelStats, Segment, StrideStats};
+use gaitclip::length::features::{self, Stat, COUNT, STATS, STRIDE_FREQUENCY, ZUPT_LENGTH};
+use gaitclip::length::fuzzy::RULES;
+use gaitclip::length::models::{Model, Settings, MAX_TERMS};
+use gaitclip::record::stride::Stride;
+use gaitclip::sensor::rate::SampleRate;
+use gaitclip::sensor::units::FOOT_LSB_PER_G;
 
-/// The features of a stride in f64, in the units of [`gaitclip::features`] (not Q16), from
+/// The features of a stride in f64, in the units of [`gaitclip::length::features`] (not Q16), from
 /// its phase statistics `stats`.
 pub fn features(stride: &Stride, stats: &StrideStats, rate: SampleRate) -> [f64; COUNT] {
     let hz = rate.millihertz() as f64 / 1000.0;
@@ -103,7 +103,7 @@ pub fn lu_k(f: f64, f_universe: (f64, f64), d: f64, d_universe: (f64, f64), step
     0.55 + (c + 3.0) / 6.0 * 0.45
 }
 
-/// The basis terms of a closed-form model in f64 (see [`gaitclip::models::basis`]);
+/// The basis terms of a closed-form model in f64 (see [`gaitclip::length::models::basis`]);
 /// `lu_d_range` is the foot range mapped onto Lu's D universe, g.
 pub fn basis(
     model: Model,
@@ -129,7 +129,7 @@ pub fn basis(
         Model::LuFuzzy => {
             // The model's centre of gravity is the firmware's discrete one (its distance to
             // the continuous integral is tested on its own in tests/lengths.rs).
-            let steps = gaitclip::fuzzy::STEPS_PER_LEVEL as usize;
+            let steps = gaitclip::length::fuzzy::STEPS_PER_LEVEL as usize;
             let range = st(Channel::Vertical, Stat::Range);
             let k = lu_k(2.0 * sf, (1.0, 2.8), range, lu_d_range, steps);
             [k * weinberg, 0.0, 0.0, 0.0]

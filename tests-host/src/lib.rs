@@ -42,5 +42,6 @@ pub mod stats;
 pub mod tables;
 pub mod trace;
 pub mod train;
+pub mod training_set;
 pub mod wake_eval;
 pub mod zupt_sweep;

@@ -20,13 +20,13 @@ pub struct Detected {
     pub foot_flat: u32,
     /// The stride's end (the next stride's start).
     pub end: u32,
-    /// The movement overflowed the movement buffer ([`gaitclip::stride::StrideFlags::TOO_LONG`]):
+    /// The movement overflowed the movement buffer ([`gaitclip::record::stride::StrideFlags::TOO_LONG`]):
     /// strides merged.
     pub too_long: bool,
 }
 
-impl From<&gaitclip::stride::Stride> for Detected {
-    fn from(s: &gaitclip::stride::Stride) -> Self {
+impl From<&gaitclip::record::stride::Stride> for Detected {
+    fn from(s: &gaitclip::record::stride::Stride) -> Self {
         Detected {
             start: s.start,
             heel_off: s.heel_off,
@@ -34,7 +34,7 @@ impl From<&gaitclip::stride::Stride> for Detected {
             heel_strike: s.heel_strike,
             foot_flat: s.foot_flat,
             end: s.end,
-            too_long: s.flags.0 & gaitclip::stride::StrideFlags::TOO_LONG != 0,
+            too_long: s.flags.0 & gaitclip::record::stride::StrideFlags::TOO_LONG != 0,
         }
     }
 }

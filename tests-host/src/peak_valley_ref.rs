@@ -4,15 +4,15 @@
 //! Shared with the core are only the definitions: the thresholds (converted to g here), the
 //! look-ahead limits in ms and the samples they round to, the filter's `α` and delay. The
 //! filtering, the comparisons and the means are done here in `f64` on the physical values.
-//! The core streams the same rules ([`gaitclip::peak_valley`]); a test checks both find the
+//! The core streams the same rules ([`gaitclip::detect::peak_valley`]); a test checks both find the
 //! same steps.
 
-use gaitclip::low_pass::{alpha_q16, LowPass, LOW_PASS_LSB_PER_G};
-use gaitclip::peak_valley::{
+use gaitclip::detect::peak_valley::{
     C_DEN, C_NUM, DYNAMIC_LOOKAHEAD_MS, DYNAMIC_WINDOW, MIN_INTERVAL_MS, NEIGHBOUR_PEAK_G,
     NEIGHBOUR_VALLEY_G, STATIC_G, STATIC_WINDOW, TH1_G, TH2_G, WALK_GAP_MS,
 };
-use gaitclip::rate::SampleRate;
+use gaitclip::sensor::rate::SampleRate;
+use gaitclip::signal::low_pass::{alpha_q16, LowPass, LOW_PASS_LSB_PER_G};
 
 /// An extreme: sample number, value in g, peak or not.
 #[derive(Clone, Copy, Debug, PartialEq)]

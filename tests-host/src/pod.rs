@@ -26,7 +26,8 @@ use std::time::Duration;
 use anyhow::{bail, Context, Result};
 use embassy_sync::blocking_mutex::raw::NoopRawMutex;
 use embedded_io_adapters::tokio_1::FromTokio;
-use gaitclip::pipeline::{Config, Pipeline};
+use gaitclip::pipeline::config::Config;
+use gaitclip::pipeline::Pipeline;
 use gaitclip_board::rsc_gatt::{self, PodEvent, PodLink, PodObserver};
 use serde_json::json;
 use trouble_host::prelude::{Address, ExternalController};
@@ -271,7 +272,7 @@ async fn feed(prepared: &Prepared, config: Config, opts: &PodOptions) {
     let start = tokio::time::Instant::now();
     let t0 = clock.t_s(0);
     let mut holes = clock.holes.iter().peekable();
-    let emit = |s: gaitclip::stride::Stride| {
+    let emit = |s: gaitclip::record::stride::Stride| {
         let r = replay::report(s, config, &|n| clock.t_s(n));
         LINK.stride(&s, embassy_time::Instant::now().as_millis() as u32);
         let mut out = std::io::stdout().lock();

@@ -11,12 +11,12 @@
 //! Without such a plateau the axis's rail is its nominal range: given (`--acc-range-g`,
 //! `--gyro-range-dps`, or `acc_range_g` / `gyro_range_dps` in a `meta.json`), or else the
 //! MPU6050 range the replay converts to (±16 g, ±2000 °/s), whose counts saturate there.
-//! The learnt or nominal rail goes to the core in counts ([`gaitclip::sample::Rails`]).
+//! The learnt or nominal rail goes to the core in counts ([`gaitclip::sensor::sample::Rails`]).
 
-use gaitclip::sample::{AxisRails, Rails};
+use gaitclip::sensor::sample::{AxisRails, Rails};
 use serde::Serialize;
 
-use crate::trace::{ImuSample, Ranges, G_MPS2};
+use crate::trace::{GivenRanges, ImuSample, Ranges, G_MPS2};
 
 /// A sample within this share of an axis's extreme value sits on the plateau (a real part's
 /// rail wanders by ±0.3 % with the other axes' cross-coupling: `esangeni_run`).
@@ -30,15 +30,6 @@ pub const MIN_EVENTS: usize = 2;
 /// An extreme below this share of the nominal range is no rail, however flat (a stance
 /// reading nothing but gravity).
 pub const MIN_SHARE_OF_RANGE: f64 = 0.5;
-
-/// The nominal ranges a recording's sensor was set to, where known.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize)]
-pub struct GivenRanges {
-    /// Accelerometer full scale, g.
-    pub acc_g: Option<f64>,
-    /// Gyroscope full scale, °/s.
-    pub gyro_dps: Option<f64>,
-}
 
 /// How one side of one axis's rail was found.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]

@@ -10,9 +10,9 @@
 //!
 //! **Why the core runs at the recording's rate, not resampled to the firmware's.** The core
 //! sizes what it keeps by time (the movement buffer holds
-//! [`gaitclip::stride::MAX_MOVEMENT_MS`] at any rate, the windows are set in milliseconds), so
+//! [`gaitclip::detect::seam::MAX_MOVEMENT_MS`] at any rate, the windows are set in milliseconds), so
 //! a 400–1000 Hz recording replays without a `too_long` stride, and a clipped run keeps its
-//! shape, which the rail reconstruction needs ([`gaitclip::clipping`]): a filter before a
+//! shape, which the rail reconstruction needs ([`gaitclip::detect::clipping`]): a filter before a
 //! resampler would smear a rail into unclipped samples below it. The table is the check that
 //! the rate-independence holds.
 
@@ -91,8 +91,8 @@ pub fn sweep(t: &Trace, factors: &[usize]) -> Result<Vec<RateResult>> {
         let (s, summary) = replay::replay_summarised(
             t,
             ranges,
-            gaitclip::pipeline::Detector::Cycle,
-            gaitclip::pipeline::DEFAULT_MODEL,
+            gaitclip::pipeline::detectors::Detector::Cycle,
+            gaitclip::pipeline::config::DEFAULT_MODEL,
             false,
         )?;
         Ok((s, summary.distance_m))

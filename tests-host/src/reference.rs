@@ -8,17 +8,18 @@
 //! computation (means, variances, rotations, deflation, quartiles, k-means, fusion) is done
 //! here in `f64` on the physical values of the same input counts.
 
-use gaitclip::foot_frame::{
+use gaitclip::detect::foot_frame::{
     AXIS_MAX_MOVEMENT_MS, AXIS_MIN_MOVEMENT_MS, FIRST_FRAME_AFTER_MS, REMOUNT_DEG,
 };
-use gaitclip::phases::{
+use gaitclip::detect::phases::{
     PhaseMethod, KMEANS_MAX_ITERATIONS, MAX_EXTREMES, MERGE_MS, MIN_EXTREME_MG,
 };
-use gaitclip::pipeline::{Config, MEAN_FILTER_MS};
-use gaitclip::rate::SampleRate;
-use gaitclip::sample::RawSample;
-use gaitclip::stride::{MAX_MOVEMENT_SAMPLES, MAX_STANCE_IN_STRIDE_MS, MIN_MOVEMENT_MS};
-use gaitclip::{rest, stance};
+use gaitclip::detect::seam::{MAX_MOVEMENT_SAMPLES, MAX_STANCE_IN_STRIDE_MS, MIN_MOVEMENT_MS};
+use gaitclip::detect::{rest, stance};
+use gaitclip::pipeline::config::Config;
+use gaitclip::pipeline::MEAN_FILTER_MS;
+use gaitclip::sensor::rate::SampleRate;
+use gaitclip::sensor::sample::RawSample;
 use nalgebra::{Matrix3, SymmetricEigen, Vector3};
 
 use crate::matching::Detected;
@@ -61,11 +62,14 @@ impl Reference {
             // Power of two nearest n, at most 16.
             (2f64.powf(n.log2().round())).min(16.0) as usize
         };
-        let t = stance::StanceThresholds::new(rate, gaitclip::sample::GyroRange::Dps2000.scale());
+        let t = stance::StanceThresholds::new(
+            rate,
+            gaitclip::sensor::sample::GyroRange::Dps2000.scale(),
+        );
         let r = rest::RestThresholds::new(
             rate,
-            gaitclip::sample::AccelRange::default().scale(),
-            gaitclip::sample::GyroRange::default().scale(),
+            gaitclip::sensor::sample::AccelRange::default().scale(),
+            gaitclip::sensor::sample::GyroRange::default().scale(),
         );
         Reference {
             filter_len,

@@ -3,13 +3,15 @@
 
 use std::collections::BTreeMap;
 
-use gaitclip::features::Features;
-use gaitclip::models::{self, Model};
-use gaitclip::phase_stats::StrideStats;
-use gaitclip::pipeline::{Config, Detector, HoleCounts, Pipeline};
-use gaitclip::rate::SampleRate;
-use gaitclip::sample::RawSample;
-use gaitclip::stride::{Stride, StrideFlags};
+use gaitclip::detect::phase_stats::StrideStats;
+use gaitclip::length::features::Features;
+use gaitclip::length::models::{self, Model};
+use gaitclip::pipeline::config::Config;
+use gaitclip::pipeline::detectors::Detector;
+use gaitclip::pipeline::{HoleCounts, Pipeline};
+use gaitclip::record::stride::{Stride, StrideFlags};
+use gaitclip::sensor::rate::SampleRate;
+use gaitclip::sensor::sample::RawSample;
 use serde::Serialize;
 
 use crate::clock::{Gap, SampleClock, TimeGoesBack};
@@ -481,7 +483,7 @@ pub fn replay(trace: &Trace, ranges: Ranges) -> Result<Vec<StrideReport>, Replay
         trace,
         ranges,
         Detector::Cycle,
-        gaitclip::pipeline::DEFAULT_MODEL,
+        gaitclip::pipeline::config::DEFAULT_MODEL,
         false,
     )
 }

@@ -15,8 +15,8 @@
 //! - our **duty factor** (stance share of the cycle) and the share of strides called running.
 
 use anyhow::Result;
-use gaitclip::gait::Gait;
-use gaitclip::stride::StrideFlags;
+use gaitclip::record::gait::Gait;
+use gaitclip::record::stride::StrideFlags;
 
 use crate::datasets;
 use crate::length_eval::SPEED_BINS;
@@ -105,7 +105,7 @@ pub fn instants(root: &std::path::Path) -> Result<Vec<Instant>> {
 /// The table, Markdown.
 pub fn report(root: &std::path::Path) -> Result<String> {
     let all = instants(root)?;
-    let h = gaitclip::cycle::SENSOR_HEIGHT_UM as f64 / 1e6;
+    let h = gaitclip::detect::cycle::SENSOR_HEIGHT_UM as f64 / 1e6;
     let mut t = Table::new([
         "Vicon speed",
         "strides",

@@ -22,7 +22,7 @@
 
 use std::f64::consts::PI;
 
-use gaitclip::sample::RawSample;
+use gaitclip::sensor::sample::RawSample;
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 use rand_distr::{Distribution, Normal};

@@ -1,7 +1,8 @@
 //! A recorded trace in physical units and its conversion to MPU6050 counts.
 
-use gaitclip::rate::SampleRate;
-use gaitclip::sample::{AccelRange, GyroRange, RawSample};
+use gaitclip::sensor::rate::SampleRate;
+use gaitclip::sensor::sample::{AccelRange, GyroRange, RawSample};
+use serde::Serialize;
 
 /// Standard gravity, m/s² per g.
 pub const G_MPS2: f64 = 9.80665;
@@ -30,7 +31,7 @@ pub struct Trace {
     pub repeated: usize,
     /// The sensor's nominal ranges, where known (`--acc-range-g`, `--gyro-range-dps`,
     /// `meta.json`): the rails where no flat run shows others ([`crate::rails`]).
-    pub given: crate::rails::GivenRanges,
+    pub given: GivenRanges,
 }
 
 /// Sensor ranges used to turn physical units into counts.
@@ -117,4 +118,13 @@ impl Trace {
         }
         Ok((keep.into_iter().map(|i| samples[i]).collect(), dropped))
     }
+}
+
+/// The nominal ranges a recording's sensor was set to, where known.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize)]
+pub struct GivenRanges {
+    /// Accelerometer full scale, g.
+    pub acc_g: Option<f64>,
+    /// Gyroscope full scale, °/s.
+    pub gyro_dps: Option<f64>,
 }

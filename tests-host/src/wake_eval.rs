@@ -19,7 +19,8 @@ use std::fmt::Write as _;
 use std::path::Path;
 
 use anyhow::{Context, Result};
-use gaitclip::pipeline::{Config, Pipeline};
+use gaitclip::pipeline::config::Config;
+use gaitclip::pipeline::Pipeline;
 use gaitclip_board::replay_mpu6050::{mg_to_counts, motion_between, REPLAY_MOTION_UNIT};
 use gaitclip_board::sleep::SLEEP;
 

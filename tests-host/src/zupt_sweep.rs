@@ -1,13 +1,13 @@
 //! `gaitclip zupt-sweep`: what the ZUPT stride's two physical settings do to its length, so
 //! that they are documented by measurement.
 //!
-//! - **Sensor height** above the foot's rolling contact ([`gaitclip::pipeline::Config`]'s
-//!   `sensor_height_um`, default [`gaitclip::cycle::SENSOR_HEIGHT_UM`]): at the stance
+//! - **Sensor height** above the foot's rolling contact ([`gaitclip::pipeline::config::Config`]'s
+//!   `sensor_height_um`, default [`gaitclip::detect::cycle::SENSOR_HEIGHT_UM`]): at the stance
 //!   instant the foot rolls and the sensor moves at `ω × (h·up)`; `h = 0` is the plain
 //!   zero-velocity update. A clip on the side of a shoe sits lower than one on the laces.
 //! - **Gyro full-scale range**: the recordings are converted to MPU6050 counts at ±2000,
 //!   ±500 and ±250 °/s; at the lower ranges the swing's pitch rate clips and the tilt the
-//!   rails lost is put back ([`gaitclip::zupt::ZuptIntegrator::displacement_restoring`]),
+//!   rails lost is put back ([`gaitclip::detect::zupt::ZuptIntegrator::displacement_restoring`]),
 //!   reported for clipped and unclipped strides apart.
 //!
 //! Scored as `gaitclip eval` scores the `zupt` model: the cycle detector's valid strides
@@ -19,9 +19,9 @@ use std::fmt::Write as _;
 use std::path::Path;
 
 use anyhow::Result;
-use gaitclip::models::Model;
-use gaitclip::sample::{AccelRange, GyroRange};
-use gaitclip::stride::StrideFlags;
+use gaitclip::length::models::Model;
+use gaitclip::record::stride::StrideFlags;
+use gaitclip::sensor::sample::{AccelRange, GyroRange};
 
 use crate::datasets;
 use crate::length_eval::SPEED_BINS;
@@ -140,7 +140,7 @@ pub fn report(root: &Path) -> Result<String> {
     writeln!(
         s,
         "\nZUPT stride by gyro full-scale range (cycle detector, sensor height {} mm; RMSE / bias cm (strides)):\n",
-        gaitclip::cycle::SENSOR_HEIGHT_UM / 1000
+        gaitclip::detect::cycle::SENSOR_HEIGHT_UM / 1000
     )?;
     write!(s, "| gyro range |")?;
     for d in &sets {
@@ -159,7 +159,7 @@ pub fn report(root: &Path) -> Result<String> {
         };
         write!(s, "| {label} |")?;
         for d in &sets {
-            let e = errors(d, ranges, gaitclip::cycle::SENSOR_HEIGHT_UM)?;
+            let e = errors(d, ranges, gaitclip::detect::cycle::SENSOR_HEIGHT_UM)?;
             let pick = |f: &dyn Fn(&Scoredstride) -> bool| -> Vec<f64> {
                 e.iter().filter(|x| f(x)).map(|x| x.1).collect()
             };

@@ -5,8 +5,8 @@ use embedded_hal::i2c::{ErrorType, I2c, Operation};
 use embedded_hal_mock::eh1::delay::NoopDelay;
 use gaitclip::mpu6050::{Address, Config, Mpu6050, OutputRate};
 use gaitclip::pipeline::Pipeline;
-use gaitclip::rate::SampleRate;
-use gaitclip::sample::{AccelRange, GyroRange, RawSample};
+use gaitclip::sensor::rate::SampleRate;
+use gaitclip::sensor::sample::{AccelRange, GyroRange, RawSample};
 use gaitclip_board::{imu_sampler, replay_mpu6050, serial_line, startup};
 use imu_sampler::{BusRecovery, Counters, ImuSampler, Item, ReadMode};
 use replay_mpu6050::{ReplayBusError, ReplayMpu6050};
@@ -168,7 +168,7 @@ fn a_full_queue_becomes_a_gap_not_a_silent_loss() {
 #[test]
 fn serial_stride_line_parses_back() {
     let rate = SampleRate::from_hz(200).unwrap();
-    let mut stride = gaitclip::stride::Stride {
+    let mut stride = gaitclip::record::stride::Stride {
         index: 7,
         start: 1000,
         heel_off: 1084,
@@ -179,10 +179,10 @@ fn serial_stride_line_parses_back() {
         climb_mm: -3,
         ..Default::default()
     };
-    stride.flags.0 = gaitclip::stride::StrideFlags::FROM_REST;
+    stride.flags.0 = gaitclip::record::stride::StrideFlags::FROM_REST;
     stride.max_sensor_lift_mm = 131;
     stride.turning_angle_cdeg = -215;
-    stride.gait = gaitclip::gait::GaitParameters::of(&stride, None, rate);
+    stride.gait = gaitclip::record::gait::GaitParameters::of(&stride, None, rate);
     let mut line = String::new();
     serial_line::stride(&mut line, rate, &stride).unwrap();
     assert!(line.len() <= serial_line::MAX_LINE);
@@ -233,8 +233,11 @@ fn serial_stride_line_parses_back() {
 fn startup_nags_until_still_then_reports_bias_and_heading() {
     let counts = gaitclip_host::fixtures::firmware_trace_counts().unwrap();
     let rate = SampleRate::from_hz(200).unwrap();
-    let cfg =
-        gaitclip::pipeline::Config::new(rate, AccelRange::G16.scale(), GyroRange::Dps2000.scale());
+    let cfg = gaitclip::pipeline::config::Config::new(
+        rate,
+        AccelRange::G16.scale(),
+        GyroRange::Dps2000.scale(),
+    );
     let mut p = Pipeline::new(cfg);
     let mut st = startup::Startup::new(rate, GyroRange::Dps2000.scale());
     let mut events = Vec::new();

@@ -9,10 +9,10 @@ use embedded_hal::i2c::{ErrorKind, ErrorType, I2c, NoAcknowledgeSource, Operatio
 use embedded_hal_mock::eh1::delay::NoopDelay;
 use embedded_hal_mock::eh1::i2c::{Mock, Transaction as T};
 use gaitclip::mpu6050::{Address, Config, Mpu6050, OutputRate};
-use gaitclip::pipeline::{self, Pipeline};
-use gaitclip::rate::SampleRate;
-use gaitclip::sample::{AccelRange, GyroRange};
-use gaitclip::stride::{Stride, StrideFlags};
+use gaitclip::pipeline::Pipeline;
+use gaitclip::record::stride::{Stride, StrideFlags};
+use gaitclip::sensor::rate::SampleRate;
+use gaitclip::sensor::sample::{AccelRange, GyroRange};
 use gaitclip_board::imu_sampler;
 use imu_sampler::{BusRecovery, Counters, ImuSampler, Item, ReadMode, RESTART_AFTER, RETRIES};
 
@@ -163,7 +163,7 @@ fn run(script: Script, pulses: usize) -> (Vec<Stride>, Vec<Item>, Counters) {
         panic!("the sensor starts");
     };
     let rate = SampleRate::from_hz(200).unwrap();
-    let mut p = Pipeline::new(pipeline::Config::new(
+    let mut p = Pipeline::new(gaitclip::pipeline::config::Config::new(
         rate,
         AccelRange::G16.scale(),
         GyroRange::Dps2000.scale(),
@@ -281,8 +281,8 @@ fn a_sensor_that_stops_mid_walk_is_restarted_and_its_stride_marked() {
     // length estimated from the two measured gait cycles before it.
     const {
         assert!(
-            OUT as u32 * 5 > gaitclip::pipeline::BRIDGE_MAX_MS
-                && OUT as u32 * 5 <= gaitclip::pipeline::FILL_MAX_MS
+            OUT as u32 * 5 > gaitclip::pipeline::config::BRIDGE_MAX_MS
+                && OUT as u32 * 5 <= gaitclip::pipeline::config::FILL_MAX_MS
         )
     };
     let gap: Vec<&Stride> = strides
@@ -366,12 +366,12 @@ fn a_fifo_overflow_becomes_a_gap_of_what_it_cost() {
     );
     let want: Vec<Item> = t[0..4]
         .iter()
-        .map(|x| Item::Sample(gaitclip::sample::RawSample::from_be_bytes(x)))
+        .map(|x| Item::Sample(gaitclip::sensor::sample::RawSample::from_be_bytes(x)))
         .chain([Item::Gap(4)])
         .chain(
             t[8..12]
                 .iter()
-                .map(|x| Item::Sample(gaitclip::sample::RawSample::from_be_bytes(x))),
+                .map(|x| Item::Sample(gaitclip::sensor::sample::RawSample::from_be_bytes(x))),
         )
         .collect();
     assert_eq!(items, want);

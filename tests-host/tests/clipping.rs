@@ -1,12 +1,13 @@
-//! The clipped accelerometer put back ([`gaitclip::clipping`]), measured on real recordings
+//! The clipped accelerometer put back ([`gaitclip::detect::clipping`]), measured on real recordings
 //! clipped on purpose (`gaitclip clipping`), and the rails learnt from the data
 //! ([`gaitclip_host::rails`]). Bounds just above the figures measured on 2026-12-03.
 
-use gaitclip::sample::{AccelRange, AxisRails, Rails};
+use gaitclip::sensor::sample::{AccelRange, AxisRails, Rails};
 use gaitclip_host::clip_sweep::{sweep, CLIPPINGS};
 use gaitclip_host::datasets::{self, root_or_skip};
 use gaitclip_host::markdown::ErrorStats;
-use gaitclip_host::rails::{learn, GivenRanges, RailSource};
+use gaitclip_host::rails::{learn, RailSource};
+use gaitclip_host::trace::GivenRanges;
 use gaitclip_host::trace::{ImuSample, Ranges, G_MPS2};
 
 #[test]

@@ -107,8 +107,8 @@ fn run(t: &Trace) -> (Vec<StrideReport>, Summary) {
     replay_summarised(
         t,
         Ranges::default(),
-        gaitclip::pipeline::Detector::Cycle,
-        gaitclip::pipeline::DEFAULT_MODEL,
+        gaitclip::pipeline::detectors::Detector::Cycle,
+        gaitclip::pipeline::config::DEFAULT_MODEL,
         false,
     )
     .unwrap()

@@ -3,7 +3,8 @@
 //! every measured call returns, and a second run counts exactly the same; with the stance
 //! detector and with Lu's peak-valley detector.
 
-use gaitclip::pipeline::{Config, Detector};
+use gaitclip::pipeline::config::Config;
+use gaitclip::pipeline::detectors::Detector;
 use gaitclip_host::cost::size_of_elf;
 use gaitclip_host::firmware::{self, repo_root};
 use gaitclip_host::insn_count;
@@ -150,9 +151,9 @@ fn bench_runs_to_the_end_on_m0_with_each_detector() {
 
 fn demo_config() -> Config {
     Config::new(
-        gaitclip::rate::SampleRate::from_millihertz(200_000).expect("200 Hz"),
-        gaitclip::sample::AccelRange::G16.scale(),
-        gaitclip::sample::GyroRange::Dps2000.scale(),
+        gaitclip::sensor::rate::SampleRate::from_millihertz(200_000).expect("200 Hz"),
+        gaitclip::sensor::sample::AccelRange::G16.scale(),
+        gaitclip::sensor::sample::GyroRange::Dps2000.scale(),
     )
 }
 

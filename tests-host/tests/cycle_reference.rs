@@ -4,7 +4,7 @@
 //! is put back on the clipped samples) and at ±8 g and ±4 g (where the accelerometer's heel
 //! strikes and push-offs clip and their loss is put back), within 1 mm of the twin.
 
-use gaitclip::sample::{AccelRange, GyroRange};
+use gaitclip::sensor::sample::{AccelRange, GyroRange};
 use gaitclip_host::cycle_ref::{self, Skipped};
 use gaitclip_host::datasets::root_or_skip;
 use gaitclip_host::trace::Ranges;
@@ -59,10 +59,14 @@ fn cycle_strides_match_the_f64_twin_within_1_mm() {
                         );
                         worst = worst.max(e);
                         measured += 1;
-                        if s.flags.has(gaitclip::stride::StrideFlags::GYRO_CLIPPED) {
+                        if s.flags
+                            .has(gaitclip::record::stride::StrideFlags::GYRO_CLIPPED)
+                        {
                             clipped += 1;
                         }
-                        if s.flags.has(gaitclip::stride::StrideFlags::ACCEL_CLIPPED) {
+                        if s.flags
+                            .has(gaitclip::record::stride::StrideFlags::ACCEL_CLIPPED)
+                        {
                             accel_clipped += 1;
                         }
                     }

@@ -159,8 +159,8 @@ fn no_stride_is_lost_between_holes() {
     for f in &files {
         let trace = csv_trace::read(f, None).unwrap();
         let prepared = gaitclip_host::replay::prepare(&trace, Ranges::default()).unwrap();
-        for detector in gaitclip::pipeline::Detector::ALL {
-            let mut config = gaitclip::pipeline::Config::new(
+        for detector in gaitclip::pipeline::detectors::Detector::ALL {
+            let mut config = gaitclip::pipeline::config::Config::new(
                 prepared.rate,
                 Ranges::default().accel.scale(),
                 Ranges::default().gyro.scale(),

@@ -9,7 +9,8 @@ fn generated_docs_are_current() {
     let Some(root) = root_or_skip("generated_docs_are_current") else {
         return;
     };
-    let pages = docs::regenerate(&docs::docs_dir(), &root).unwrap();
+    let exe = std::path::Path::new(env!("CARGO_BIN_EXE_gaitclip"));
+    let pages = docs::regenerate(&docs::docs_dir(), &root, exe).unwrap();
     assert!(!pages.is_empty());
     let stale: Vec<String> = pages
         .iter()

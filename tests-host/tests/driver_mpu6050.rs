@@ -8,7 +8,7 @@ use gaitclip::mpu6050::{
     Address, Config, Error, MotionThreshold, MotionThresholdUnit, MotionWake, Mpu6050, OutputRate,
     WakeRate,
 };
-use gaitclip::sample::{AccelRange, GyroRange, RawSample};
+use gaitclip::sensor::sample::{AccelRange, GyroRange, RawSample};
 
 const ADDR: u8 = 0x68;
 const SMPLRT_DIV: u8 = 0x19;

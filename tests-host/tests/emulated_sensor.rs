@@ -3,7 +3,7 @@
 
 use embedded_hal_mock::eh1::delay::NoopDelay;
 use gaitclip::mpu6050::{Address, Config, Error, Mpu6050, OutputRate};
-use gaitclip::sample::RawSample;
+use gaitclip::sensor::sample::RawSample;
 use gaitclip_board::replay_mpu6050;
 use replay_mpu6050::{ReplayBusError, ReplayMpu6050};
 

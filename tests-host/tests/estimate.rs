@@ -1,8 +1,8 @@
-//! The estimate for strides that could not be measured ([`gaitclip::estimate`]), and that
+//! The estimate for strides that could not be measured ([`gaitclip::length::estimate`]), and that
 //! every stride the detector finds counts in the distance.
 
-use gaitclip::estimate::LengthEstimator;
-use gaitclip::stride::{Stride, StrideFlags};
+use gaitclip::length::estimate::LengthEstimator;
+use gaitclip::record::stride::{Stride, StrideFlags};
 use gaitclip_host::datasets::root_or_skip;
 use gaitclip_host::trace::Ranges;
 use gaitclip_host::{csv_trace, datasets, replay};
@@ -83,8 +83,8 @@ fn every_stride_of_every_dataset_counts_in_the_distance() {
             let (s, summary) = replay::replay_summarised(
                 &t,
                 Ranges::default(),
-                gaitclip::pipeline::Detector::Cycle,
-                gaitclip::pipeline::DEFAULT_MODEL,
+                gaitclip::pipeline::detectors::Detector::Cycle,
+                gaitclip::pipeline::config::DEFAULT_MODEL,
                 false,
             )
             .unwrap();

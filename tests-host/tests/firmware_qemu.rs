@@ -3,10 +3,11 @@
 //! fixture from flash through the emulated sensor bus and the real driver, logs the same
 //! per-stride integers as the host replay of the same fixture.
 
-use gaitclip::pipeline::{Config, Detector};
-use gaitclip::rate::SampleRate;
-use gaitclip::sample::RawSample;
-use gaitclip::stride::{Stride, StrideFlags};
+use gaitclip::pipeline::config::Config;
+use gaitclip::pipeline::detectors::Detector;
+use gaitclip::record::stride::{Stride, StrideFlags};
+use gaitclip::sensor::rate::SampleRate;
+use gaitclip::sensor::sample::RawSample;
 use gaitclip_board::sleep::{SleepPolicy, SLEEP};
 use gaitclip_board::{replay_holes, replay_mpu6050, replay_still};
 use gaitclip_host::clock::Gap;
@@ -91,7 +92,7 @@ fn qemu_m0_bridges_holes_as_the_host_replay() {
     // runs into the stand after it, longer than that buffer holds (flagged too long there).
     let host_strides = {
         let mut p = gaitclip::pipeline::Pipeline::<
-            gaitclip::detector::AnyDetector<MICROBIT_MOVEMENT_SAMPLES>,
+            gaitclip::pipeline::detectors::AnyDetector<MICROBIT_MOVEMENT_SAMPLES>,
         >::sized(config);
         let mut out = Vec::new();
         let mut next_gap = gaps.iter().peekable();
@@ -255,7 +256,10 @@ fn sleeping_host_model<const M: usize>(
     trace: &[RawSample],
     config: Config,
 ) -> (Vec<Stride>, u32, u32, u32) {
-    let mut p = gaitclip::pipeline::Pipeline::<gaitclip::detector::AnyDetector<M>>::sized(config);
+    let mut p =
+        gaitclip::pipeline::Pipeline::<gaitclip::pipeline::detectors::AnyDetector<M>>::sized(
+            config,
+        );
     let mut policy = SleepPolicy::new(config.rate, &SLEEP);
     let period = (config.rate.millihertz() / SLEEP.wake.rate.millihertz()) as usize;
     let threshold = replay_mpu6050::mg_to_counts(

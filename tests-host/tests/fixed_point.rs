@@ -1,13 +1,13 @@
 //! Every fixed-point routine of the core against an f64 reference, with the error bound its
 //! doc comment states.
 
+use gaitclip::detect::rest::{RestSums, RestThresholds, ACCEL_STD_MAX_MMPS2, GYRO_RMS_MAX_MRADPS};
+use gaitclip::detect::stance::{deflate, StanceThresholds, DEFLATED_IQR_MAX, DEFLATED_STD_MAX};
+use gaitclip::detect::zupt::ZuptIntegrator;
 use gaitclip::fixed::{isqrt_u64, mul_q30, QuatQ30, Q30_ONE};
-use gaitclip::mean_filter::MeanFilter;
-use gaitclip::rate::SampleRate;
-use gaitclip::rest::{RestSums, RestThresholds, ACCEL_STD_MAX_MMPS2, GYRO_RMS_MAX_MRADPS};
-use gaitclip::sample::{AccelRange, GyroRange, RawSample};
-use gaitclip::stance::{deflate, StanceThresholds, DEFLATED_IQR_MAX, DEFLATED_STD_MAX};
-use gaitclip::zupt::ZuptIntegrator;
+use gaitclip::sensor::rate::SampleRate;
+use gaitclip::sensor::sample::{AccelRange, GyroRange, RawSample};
+use gaitclip::signal::mean_filter::MeanFilter;
 use gaitclip_host::fixtures::FIRMWARE_TRACE;
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
@@ -259,8 +259,8 @@ fn deflate_is_the_signed_square_within_one_unit() {
 
 #[test]
 fn foot_frame_rotation_matches_f64_within_one_unit() {
-    use gaitclip::foot_frame::FootFrameEstimator;
-    use gaitclip::sample::RawSample;
+    use gaitclip::detect::foot_frame::FootFrameEstimator;
+    use gaitclip::sensor::sample::RawSample;
     let mut r = rng();
     for range in [AccelRange::G16, AccelRange::G2] {
         for _ in 0..20 {
@@ -446,7 +446,7 @@ fn zupt_displacement_matches_f64_reference_within_1mm() {
         assert!(z.start(&sums));
         movement
             .iter()
-            .for_each(|s| z.process(s, &gaitclip::sample::Rails::FULL_SCALE));
+            .for_each(|s| z.process(s, &gaitclip::sensor::sample::Rails::FULL_SCALE));
         let d = z.displacement();
         let ZuptF64 {
             horizontal: h,
@@ -544,7 +544,7 @@ fn axes(s: &RawSample) -> [i16; 7] {
 /// (within ½ count of f64), for any samples and hole lengths up to the fill limit.
 #[test]
 fn bridge_line_is_the_rounded_straight_line() {
-    use gaitclip::bridge::linear;
+    use gaitclip::signal::bridge::linear;
     let mut r = rng();
     let mut worst = 0f64;
     for _ in 0..20_000 {
@@ -567,7 +567,7 @@ fn bridge_line_is_the_rounded_straight_line() {
 /// range, the rail where it is not; and a cubic in time comes back to the count.
 #[test]
 fn bridge_cubic_is_the_rounded_lagrange_cubic() {
-    use gaitclip::bridge::cubic;
+    use gaitclip::signal::bridge::cubic;
     let mut r = rng();
     let mut worst = 0f64;
     for _ in 0..20_000 {
@@ -634,9 +634,9 @@ fn gyro_counts_of_mrad_per_s_within_half_a_count() {
 /// units, 10⁻⁵ relative, and what the integer |f| (floored, ≤ 1 count low) can change.
 #[test]
 fn cycle_energy_matches_f64_within_its_bound() {
-    use gaitclip::cycle::CycleConfig;
-    use gaitclip::phases::PhaseMethod;
-    use gaitclip::pipeline::Config;
+    use gaitclip::detect::cycle::CycleConfig;
+    use gaitclip::detect::phases::PhaseMethod;
+    use gaitclip::pipeline::config::Config;
     let mut r = rng();
     let rate = SampleRate::from_hz(200).unwrap();
     for (accel, gyro) in [
@@ -648,7 +648,7 @@ fn cycle_energy_matches_f64_within_its_bound() {
             rate,
             accel.scale(),
             gyro.scale(),
-            gaitclip::sample::Rails::FULL_SCALE,
+            gaitclip::sensor::sample::Rails::FULL_SCALE,
             PhaseMethod::MajorPairs,
             80_000,
         );
@@ -691,7 +691,7 @@ fn cycle_energy_matches_f64_within_its_bound() {
 /// The rolling contact's velocity `ω × (h·up)` against f64: 10⁻⁴ relative, 10 µm/s absolute.
 #[test]
 fn rolling_contact_velocity_matches_f64() {
-    use gaitclip::zupt::RollingContact;
+    use gaitclip::detect::zupt::RollingContact;
     let mut r = rng();
     for (hz, gyro) in [
         (100, GyroRange::Dps2000),
@@ -732,8 +732,8 @@ fn rolling_contact_velocity_matches_f64() {
 /// one sample more than the peak spends above it).
 #[test]
 fn rail_run_reconstructs_a_clipped_peak() {
-    use gaitclip::clipping::RailRun;
-    use gaitclip::sample::AxisRails;
+    use gaitclip::detect::clipping::RailRun;
+    use gaitclip::sensor::sample::AxisRails;
     let mut ratios = Vec::new();
     for (peak, half_width) in [
         (40_000.0, 6.0),

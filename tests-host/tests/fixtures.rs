@@ -3,7 +3,7 @@
 
 use std::path::PathBuf;
 
-use gaitclip::rate::SampleRate;
+use gaitclip::sensor::rate::SampleRate;
 use gaitclip_host::csv_trace;
 use gaitclip_host::fixtures::{self, FIRMWARE_TRACE};
 use gaitclip_host::replay::{replay, replay_counts};
@@ -114,9 +114,10 @@ fn replay_finds_simulated_strides() {
 /// at 200 Hz) under 16 KiB.
 #[test]
 fn pipeline_state_is_bounded() {
-    const M: usize = gaitclip::stride::movement_samples(200);
-    let bytes =
-        std::mem::size_of::<gaitclip::pipeline::Pipeline<gaitclip::detector::AnyDetector<M>>>();
+    const M: usize = gaitclip::detect::seam::movement_samples(200);
+    let bytes = std::mem::size_of::<
+        gaitclip::pipeline::Pipeline<gaitclip::pipeline::detectors::AnyDetector<M>>,
+    >();
     eprintln!("Pipeline state: {bytes} bytes");
     assert!(bytes < 16 * 1024, "{bytes}");
 }

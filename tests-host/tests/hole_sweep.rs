@@ -5,7 +5,7 @@
 //! limit is the one the sweep chooses. Skipped with a message without `../shared/datasets`
 //! (a failure in CI).
 
-use gaitclip::pipeline::BRIDGE_MAX_MS;
+use gaitclip::pipeline::config::BRIDGE_MAX_MS;
 use gaitclip_host::datasets::root_or_skip;
 use gaitclip_host::hole_sweep::{cost, patterns, walks, Cost, MEAN_LENGTH_BOUND_M};
 

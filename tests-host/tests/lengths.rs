@@ -1,13 +1,13 @@
 //! The fixed-point length stage against its f64 reference (roots, exp, Lu's fuzzy k,
 //! features, basis terms), and Zhang's model fitted on the paper's own Table 1.
 
-use gaitclip::features::{self, Features, COUNT};
+use gaitclip::detect::phase_stats::StrideStats;
 use gaitclip::fixed::{exp_neg_q32, root_q16, tenth_root_q16};
-use gaitclip::fuzzy::{lu_k_q16, D_UNIVERSE_Q16, F_UNIVERSE_Q16};
-use gaitclip::models::{self, Model, Settings, MAX_TERMS};
-use gaitclip::phase_stats::StrideStats;
-use gaitclip::rate::SampleRate;
-use gaitclip::stride::Stride;
+use gaitclip::length::features::{self, Features, COUNT};
+use gaitclip::length::fuzzy::{lu_k_q16, D_UNIVERSE_Q16, F_UNIVERSE_Q16};
+use gaitclip::length::models::{self, Model, Settings, MAX_TERMS};
+use gaitclip::record::stride::Stride;
+use gaitclip::sensor::rate::SampleRate;
 use gaitclip_host::fit::least_squares;
 use gaitclip_host::length_ref;
 use rand::{Rng, SeedableRng};
@@ -181,7 +181,7 @@ fn features_match_f64_reference() {
 #[test]
 fn basis_terms_match_f64_reference() {
     let rate = SampleRate::from_millihertz(200_000).unwrap();
-    let params = &gaitclip::trained::PARAMS;
+    let params = &gaitclip::length::trained::PARAMS;
     let lu = (
         params.lu_d_range_q16.0 as f64 / Q16,
         params.lu_d_range_q16.1 as f64 / Q16,
@@ -290,15 +290,15 @@ fn zhang_fit_on_the_papers_table_1() {
     assert!(rz < 0.05, "Zhang residual {rz} m");
     // The same coefficients, through the firmware's fixed-point model, give the same
     // step lengths (within 1 mm) from features made to carry the table's f and var.
-    let mut params = gaitclip::trained::PARAMS;
+    let mut params = gaitclip::length::trained::PARAMS;
     params.linear[Model::Zhang.linear_index().unwrap()] =
         cz.map(|c| (c * 1e6 * Q16).round() as i64);
     for (row, want) in ZHANG_TABLE_1.iter().zip(&zhang) {
         let mut f = Features([0; COUNT]);
         f.0[features::STRIDE_FREQUENCY] = (row[1] * Q16).round() as i64;
         let var = features::index(
-            gaitclip::phase_stats::Segment::Movement,
-            gaitclip::phase_stats::Channel::Vertical,
+            gaitclip::detect::phase_stats::Segment::Movement,
+            gaitclip::detect::phase_stats::Channel::Vertical,
             features::Stat::Variance,
         );
         f.0[var] = (row[2] * Q16).round() as i64;
@@ -315,15 +315,16 @@ fn zhang_fit_on_the_papers_table_1() {
 /// other 105 features) gives the length the full features give, on every demo stride.
 #[test]
 fn the_zupt_shortcut_gives_the_full_features_length() {
-    use gaitclip::features::Features;
-    use gaitclip::models::{predict_mm, Model, Settings};
+    use gaitclip::length::features::Features;
+    use gaitclip::length::models::{predict_mm, Model, Settings};
     let counts = gaitclip_host::fixtures::firmware_trace_counts().unwrap();
-    let rate = gaitclip::rate::SampleRate::from_hz(200).unwrap();
+    let rate = gaitclip::sensor::rate::SampleRate::from_hz(200).unwrap();
     let ranges = gaitclip_host::trace::Ranges::default();
-    let config = gaitclip::pipeline::Config::new(rate, ranges.accel.scale(), ranges.gyro.scale());
+    let config =
+        gaitclip::pipeline::config::Config::new(rate, ranges.accel.scale(), ranges.gyro.scale());
     let (strides, _) = gaitclip_host::replay::core_run_with_stats(&counts, &[], config);
     assert!(strides.len() >= 20);
-    let p = &gaitclip::trained::PARAMS;
+    let p = &gaitclip::length::trained::PARAMS;
     for (s, stats) in &strides {
         let full = predict_mm(
             Model::Zupt,

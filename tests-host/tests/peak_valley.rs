@@ -5,9 +5,9 @@
 //! The rule tests feed the filtered signal directly ([`PeakValleyDetector::process_filtered`])
 //! as straight lines between knots, so that every extreme is a knot with an exact value.
 
-use gaitclip::low_pass::{alpha_q16, LowPass, LOW_PASS_LSB_PER_G};
-use gaitclip::peak_valley::{max_latency_ms, PeakValleyDetector, Step};
-use gaitclip::rate::SampleRate;
+use gaitclip::detect::peak_valley::{max_latency_ms, PeakValleyDetector, Step};
+use gaitclip::sensor::rate::SampleRate;
+use gaitclip::signal::low_pass::{alpha_q16, LowPass, LOW_PASS_LSB_PER_G};
 use gaitclip_host::peak_valley_ref;
 use gaitclip_host::{csv_trace, datasets};
 use proptest::prelude::*;

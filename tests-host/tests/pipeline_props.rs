@@ -1,11 +1,12 @@
 //! Property tests of the core on arbitrary input: never a panic (overflow checks are on in
 //! tests), state bounded by its constants, and every stride well formed.
 
-use gaitclip::detector::AnyDetector;
-use gaitclip::pipeline::{Config, Pipeline, BRIDGE_MAX_MS, FILL_MAX_MS};
-use gaitclip::rate::SampleRate;
-use gaitclip::sample::{AccelRange, GyroRange, RawSample};
-use gaitclip::stride::{Stride, StrideFlags, MAX_STRIDE_MM};
+use gaitclip::pipeline::config::{Config, BRIDGE_MAX_MS, FILL_MAX_MS};
+use gaitclip::pipeline::detectors::AnyDetector;
+use gaitclip::pipeline::Pipeline;
+use gaitclip::record::stride::{Stride, StrideFlags, MAX_STRIDE_MM};
+use gaitclip::sensor::rate::SampleRate;
+use gaitclip::sensor::sample::{AccelRange, GyroRange, RawSample};
 use proptest::prelude::*;
 
 fn sample() -> impl Strategy<Value = RawSample> {

@@ -3,8 +3,9 @@
 
 use std::path::Path;
 
-use gaitclip::phases::PhaseMethod;
-use gaitclip::pipeline::{Config, Detector};
+use gaitclip::detect::phases::PhaseMethod;
+use gaitclip::pipeline::config::Config;
+use gaitclip::pipeline::detectors::Detector;
 use gaitclip_host::datasets;
 use gaitclip_host::matching::Detected;
 use gaitclip_host::trace::{Ranges, Trace};

@@ -6,8 +6,8 @@
 //! u16 / 256 m/s; cadence u8; stride length u16 cm if flags & 0x01; total distance u32 dm if
 //! flags & 0x02; running if flags & 0x04.
 
-use gaitclip::gait::{Gait, GaitParameters};
-use gaitclip::stride::{Stride, StrideFlags};
+use gaitclip::record::gait::{Gait, GaitParameters};
+use gaitclip::record::stride::{Stride, StrideFlags};
 use gaitclip_board::rsc::{self, ControlPointRefusal, FootPod, Measurement};
 
 /// What Nordic's decoder reads from a notification: running, speed m/s, cadence, stride
@@ -78,7 +78,11 @@ fn stride(length_mm: u32, gait: Gait, flags: u16) -> Stride {
         flags: StrideFlags(flags),
         ..Stride::default()
     };
-    s.gait = GaitParameters::of(&s, None, gaitclip::rate::SampleRate::from_hz(200).unwrap());
+    s.gait = GaitParameters::of(
+        &s,
+        None,
+        gaitclip::sensor::rate::SampleRate::from_hz(200).unwrap(),
+    );
     s.gait.gait = gait;
     s
 }

@@ -137,7 +137,7 @@ fn advertising_data_names_the_rsc_service() {
 #[test]
 fn strides_count_without_a_central() {
     let link = PodLink::new();
-    let mut s = gaitclip::stride::Stride {
+    let mut s = gaitclip::record::stride::Stride {
         end: 220,
         length_mm: 1400,
         ..Default::default()

@@ -4,8 +4,8 @@
 
 use embedded_hal_mock::eh1::delay::NoopDelay;
 use gaitclip::mpu6050::{Address, Config, Mpu6050, OutputRate};
-use gaitclip::rate::SampleRate;
-use gaitclip::sample::RawSample;
+use gaitclip::sensor::rate::SampleRate;
+use gaitclip::sensor::sample::RawSample;
 use gaitclip_board::imu_sampler::{ImuSampler, Item, ReadMode};
 use gaitclip_board::replay_mpu6050::{
     mg_to_counts, motion_between, periods_per_wake, ReplayMpu6050, WakeTick, REPLAY_MOTION_UNIT,

@@ -6,7 +6,7 @@
 
 use std::path::PathBuf;
 
-use gaitclip::pipeline::{BRIDGE_MAX_MS, FILL_MAX_MS};
+use gaitclip::pipeline::config::{BRIDGE_MAX_MS, FILL_MAX_MS};
 use gaitclip_host::clock::{drop_repeats, Gap, SampleClock, TimeGoesBack};
 use gaitclip_host::csv_trace;
 use gaitclip_host::replay::{replay, replay_summarised, StrideReport};
@@ -159,8 +159,8 @@ fn a_short_hole_in_a_swing_is_bridged_and_the_stride_measured() {
     let (got, summary) = replay_summarised(
         &cut(at, 2),
         Ranges::default(),
-        gaitclip::pipeline::Detector::Cycle,
-        gaitclip::pipeline::DEFAULT_MODEL,
+        gaitclip::pipeline::detectors::Detector::Cycle,
+        gaitclip::pipeline::config::DEFAULT_MODEL,
         false,
     )
     .unwrap();
@@ -309,7 +309,7 @@ fn samples_at_the_rails_flag_the_stride() {
     t.samples[i].acc_mps2[2] = 12.0 * G_MPS2;
     let spike16 = replay(&t, Ranges::default()).unwrap();
     let at8 = Ranges {
-        accel: gaitclip::sample::AccelRange::G8,
+        accel: gaitclip::sensor::sample::AccelRange::G8,
         ..Ranges::default()
     };
     let got = replay(&t, at8).unwrap();
@@ -327,8 +327,8 @@ fn samples_at_the_rails_flag_the_stride() {
     let stance = gaitclip_host::replay::replay_model(
         &t,
         at8,
-        gaitclip::pipeline::Detector::Stance,
-        gaitclip::pipeline::DEFAULT_MODEL,
+        gaitclip::pipeline::detectors::Detector::Stance,
+        gaitclip::pipeline::config::DEFAULT_MODEL,
         false,
     )
     .unwrap();

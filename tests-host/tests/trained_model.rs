@@ -1,4 +1,4 @@
-//! The shipped models (`src/trained.rs`) against the training code and the recordings
+//! The shipped models (`src/length/trained.rs`) against the training code and the recordings
 //! (skipped with a message when `../shared/datasets` is absent; a failure in CI):
 //!
 //! - the committed file is exactly what `gaitclip train` writes today (not stale);
@@ -8,11 +8,11 @@
 //!   out of dataset: per-stride RMSE ≤ 4 cm on `gaitmap_walk`, ≤ 5 cm on `pyshoe_vicon`,
 //!   |bias| ≤ 1 cm on both.
 
-use gaitclip::features::Features;
-use gaitclip::models::{self, Model};
-use gaitclip::pipeline::DEFAULT_MODEL;
+use gaitclip::length::features::Features;
+use gaitclip::length::models::{self, Model};
+use gaitclip::pipeline::config::DEFAULT_MODEL;
 use gaitclip_host::datasets::root_or_skip;
-use gaitclip_host::{codegen, datasets, train};
+use gaitclip_host::{codegen, datasets, train, training_set};
 
 #[test]
 fn shipped_models_are_current_exact_and_meet_targets() {
@@ -21,17 +21,20 @@ fn shipped_models_are_current_exact_and_meet_targets() {
     };
     let mut runs = Vec::new();
     for name in ["gaitmap_walk", "pyshoe_vicon", "ipol_gait_events"] {
-        runs.extend(train::run_dataset(&datasets::load(&root.join(name)).unwrap()).unwrap());
+        runs.extend(training_set::run_dataset(&datasets::load(&root.join(name)).unwrap()).unwrap());
     }
 
     // 1. Not stale.
     let t = train::train(&runs).unwrap();
     let source = codegen::rust_source(&t);
-    let committed =
-        std::fs::read_to_string(concat!(env!("CARGO_MANIFEST_DIR"), "/../src/trained.rs")).unwrap();
+    let committed = std::fs::read_to_string(concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/../src/length/trained.rs"
+    ))
+    .unwrap();
     assert!(
         source == committed,
-        "src/trained.rs is stale: regenerate it with `cargo run --release --bin gaitclip -- train` in tests-host/"
+        "src/length/trained.rs is stale: regenerate it with `cargo run --release --bin gaitclip -- train` in tests-host/"
     );
 
     // 2. Fixed point (the shipped tables) against f64 (the fit just made), every stride.
@@ -41,9 +44,10 @@ fn shipped_models_are_current_exact_and_meet_targets() {
         for ((x, s), stats) in run.x.iter().zip(&run.strides).zip(&run.stats) {
             let f = Features::of(s, stats, run.rate);
             for m in Model::ALL {
-                let fixed_m = models::predict_um(m, &f, run.settings, &gaitclip::trained::PARAMS)
-                    .unwrap() as f64
-                    / 1e6;
+                let fixed_m =
+                    models::predict_um(m, &f, run.settings, &gaitclip::length::trained::PARAMS)
+                        .unwrap() as f64
+                        / 1e6;
                 let exact = t.trained.predict_f64(m, x, run.settings);
                 let d = (fixed_m - exact).abs();
                 if d > worst.0 {
@@ -67,7 +71,7 @@ fn shipped_models_are_current_exact_and_meet_targets() {
         DEFAULT_MODEL, t.default_model,
         "DEFAULT_MODEL is not the LODO best"
     );
-    assert_eq!(DEFAULT_MODEL, gaitclip::trained::LODO_BEST);
+    assert_eq!(DEFAULT_MODEL, gaitclip::length::trained::LODO_BEST);
     let get = |d: &str| &t.lodo.iter().find(|s| s.0 == d).unwrap().1[DEFAULT_MODEL as usize];
     for (name, rmse_max) in [("gaitmap_walk", 0.04), ("pyshoe_vicon", 0.05)] {
         let s = get(name);

@@ -22,11 +22,11 @@
 
 use embedded_hal::delay::DelayNs;
 use embedded_hal::i2c::I2c;
-use gaitclip::detector::StepDetector;
+use gaitclip::detect::seam::StepDetector;
 use gaitclip::mpu6050::{self, MotionWake, Mpu6050};
 use gaitclip::pipeline::Pipeline;
-use gaitclip::sample::RawSample;
-use gaitclip::stride::Stride;
+use gaitclip::record::stride::Stride;
+use gaitclip::sensor::sample::RawSample;
 
 /// Immediate retries of a failed read.
 pub const RETRIES: u32 = 2;

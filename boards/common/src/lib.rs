@@ -27,18 +27,18 @@
 #![no_std]
 #![deny(missing_docs)]
 
-use gaitclip::pipeline::Detector;
+use gaitclip::pipeline::detectors::Detector;
 
 /// The firmware's step detector: one stance instant per gait cycle (the every-pace
-/// detector, [`gaitclip::cycle`]), unless the board is built with the `peak-valley-detector`
-/// feature (Lu's detection and chain, [`gaitclip::peak_valley`]). A board's pipeline is a
+/// detector, [`gaitclip::detect::cycle`]), unless the board is built with the `peak-valley-detector`
+/// feature (Lu's detection and chain, [`gaitclip::detect::peak_valley`]). A board's pipeline is a
 /// `Pipeline<Steps<M>>` made with `Steps::new`, `M` its movement buffer: it links only this
 /// detector.
 #[cfg(not(feature = "peak-valley-detector"))]
-pub type Steps<const M: usize> = gaitclip::cycle::CycleDetector<M>;
+pub type Steps<const M: usize> = gaitclip::detect::cycle::CycleDetector<M>;
 /// The firmware's step detector (see the other configuration's documentation).
 #[cfg(feature = "peak-valley-detector")]
-pub type Steps<const M: usize> = gaitclip::peak_valley::PeakValleySteps;
+pub type Steps<const M: usize> = gaitclip::detect::peak_valley::PeakValleySteps;
 /// The name of [`Steps`], for the configuration and the logs.
 pub const DETECTOR: Detector = if cfg!(feature = "peak-valley-detector") {
     Detector::PeakValley

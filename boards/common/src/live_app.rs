@@ -14,10 +14,11 @@ use cortex_m::interrupt::{self as irq, Mutex};
 use embedded_hal::delay::DelayNs;
 use embedded_hal::digital::OutputPin;
 use embedded_hal::i2c::I2c;
-use gaitclip::detector::StepDetector;
+use gaitclip::detect::seam::StepDetector;
 use gaitclip::mpu6050::{self, Mpu6050};
-use gaitclip::pipeline::{Config, Pipeline};
-use gaitclip::stride::Stride;
+use gaitclip::pipeline::config::Config;
+use gaitclip::pipeline::Pipeline;
+use gaitclip::record::stride::Stride;
 use heapless::spsc::{Consumer, Producer, Queue};
 
 use crate::imu_sampler::{BusRecovery, Counters, ImuSampler, Item, ReadMode};

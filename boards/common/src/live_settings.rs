@@ -3,9 +3,9 @@
 //! (`gaitclip cost`) reads the same figures the firmware uses.
 
 use gaitclip::mpu6050;
-use gaitclip::pipeline::Config;
-use gaitclip::rate::SampleRate;
-use gaitclip::sample::{AccelRange, GyroRange};
+use gaitclip::pipeline::config::Config;
+use gaitclip::sensor::rate::SampleRate;
+use gaitclip::sensor::sample::{AccelRange, GyroRange};
 
 /// Output data rate of the sensor, Hz.
 pub const RATE_HZ: u16 = 200;
@@ -17,8 +17,8 @@ pub const QUEUE_LEN: usize = 128;
 pub const ACCEL: AccelRange = AccelRange::G16;
 /// ±2000 °/s: a sprinting swing reaches 1 500 °/s.
 pub const GYRO: GyroRange = GyroRange::Dps2000;
-/// The movement buffer: [`gaitclip::stride::MAX_MOVEMENT_MS`] at [`RATE_HZ`] (1 024 samples).
-pub const MOVEMENT_SAMPLES: usize = gaitclip::stride::movement_samples(RATE_HZ as u32);
+/// The movement buffer: [`gaitclip::detect::seam::MAX_MOVEMENT_MS`] at [`RATE_HZ`] (1 024 samples).
+pub const MOVEMENT_SAMPLES: usize = gaitclip::detect::seam::movement_samples(RATE_HZ as u32);
 /// [`RATE_HZ`] as the core's rate.
 pub const RATE: SampleRate = sample_rate(RATE_HZ);
 /// The sensor's configuration.

@@ -18,11 +18,12 @@ use core::sync::atomic::{AtomicBool, Ordering};
 
 use cortex_m::interrupt as irq;
 use cortex_m_semihosting::debug::{self, EXIT_FAILURE, EXIT_SUCCESS};
-use gaitclip::detector::StepDetector;
+use gaitclip::detect::seam::StepDetector;
 use gaitclip::mpu6050::{self, Address, Mpu6050};
-use gaitclip::pipeline::{Config, Pipeline};
-use gaitclip::rate::SampleRate;
-use gaitclip::sample::{AccelRange, GyroRange, SAMPLE_BYTES};
+use gaitclip::pipeline::config::Config;
+use gaitclip::pipeline::Pipeline;
+use gaitclip::sensor::rate::SampleRate;
+use gaitclip::sensor::sample::{AccelRange, GyroRange, SAMPLE_BYTES};
 use heapless::spsc::Queue;
 
 use crate::imu_sampler::{ImuSampler, Item, ReadMode};
@@ -68,9 +69,9 @@ const ACCEL: AccelRange = unwrap(AccelRange::from_afs_sel(trace::ACCEL_AFS_SEL))
 const GYRO: GyroRange = unwrap(GyroRange::from_fs_sel(trace::GYRO_FS_SEL));
 /// The pipeline's configuration for the stored trace.
 pub const CONFIG: Config = crate::live_settings::config(RATE, ACCEL, GYRO);
-/// The movement buffer: [`gaitclip::stride::MAX_MOVEMENT_MS`] at the trace's rate.
+/// The movement buffer: [`gaitclip::detect::seam::MAX_MOVEMENT_MS`] at the trace's rate.
 pub const MOVEMENT_SAMPLES: usize =
-    gaitclip::stride::movement_samples(trace::RATE_MILLIHERTZ.div_ceil(1000));
+    gaitclip::detect::seam::movement_samples(trace::RATE_MILLIHERTZ.div_ceil(1000));
 const SENSOR: mpu6050::Config =
     crate::live_settings::sensor_config((trace::RATE_MILLIHERTZ / 1000) as u16, ACCEL, GYRO);
 

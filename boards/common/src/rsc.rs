@@ -11,8 +11,8 @@
 //! | bytes | field | unit | from the stride |
 //! |---|---|---|---|
 //! | 1 | flags: bit 0 stride length present, bit 1 total distance present, bit 2 running | | [`Gait::Running`] sets bit 2 |
-//! | 2 | instantaneous speed | 1/256 m/s | [`gaitclip::gait::GaitParameters::gait_velocity_mm_s`] |
-//! | 1 | instantaneous cadence | 1/min: the sensor's foot's contacts, strides per minute | half [`gaitclip::gait::GaitParameters::cadence_spm`], rounded (saturated at 255) |
+//! | 2 | instantaneous speed | 1/256 m/s | [`gaitclip::record::gait::GaitParameters::gait_velocity_mm_s`] |
+//! | 1 | instantaneous cadence | 1/min: the sensor's foot's contacts, strides per minute | half [`gaitclip::record::gait::GaitParameters::cadence_spm`], rounded (saturated at 255) |
 //! | 2 | instantaneous stride length (if bit 0) | cm | [`Stride::length_mm`], for a stride that counts in the distance (measured, or estimated) |
 //! | 4 | total distance (if bit 1) | dm | [`FootPod::total_distance_dm`] |
 //!
@@ -21,11 +21,11 @@
 //! represents the distance between two successive contacts of the same foot to the ground"
 //! (RSCS v1.0, 2012-08-07, §2 and the RSC Measurement characteristic). Both are per stride of
 //! the instrumented foot: the cadence sent is strides per minute, half the steps per minute
-//! of both feet ([`gaitclip::gait::GaitParameters::cadence_spm`]) that the logs and the
+//! of both feet ([`gaitclip::record::gait::GaitParameters::cadence_spm`]) that the logs and the
 //! JSON give. Consumers differ in what they make of it: the README's interoperability table.
 
-use gaitclip::gait::Gait;
-use gaitclip::stride::Stride;
+use gaitclip::record::gait::Gait;
+use gaitclip::record::stride::Stride;
 
 /// The service.
 pub const SERVICE_UUID: u16 = 0x1814;

@@ -27,7 +27,7 @@ use embassy_sync::blocking_mutex::Mutex;
 use embassy_sync::channel::Channel;
 use embassy_sync::signal::Signal;
 use embassy_time::{Duration, Instant, Timer};
-use gaitclip::stride::Stride;
+use gaitclip::record::stride::Stride;
 use trouble_host::prelude::*;
 
 use crate::rsc::{self, FootPod, Measurement, MAX_MEASUREMENT_LEN};

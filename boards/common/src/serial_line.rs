@@ -18,7 +18,7 @@
 //!
 //! `index` counts strides from 0; `t_ms` is the start of the stride since power-up;
 //! `duration_ms` is the whole stride and the four phase columns add up to it; `flags` is
-//! the bit set of [`gaitclip::stride::StrideFlags`] (1 saturated, 2 too long, 4 from rest,
+//! the bit set of [`gaitclip::record::stride::StrideFlags`] (1 saturated, 2 too long, 4 from rest,
 //! 8 to rest, 16 turn, 32 phases guessed, 64 gap, 128 implausible, 256 bridged, 512 gyro
 //! clipped and restored); `valid` is 0 when a flag
 //! makes the length untrustworthy (a gap stride has length 0). The columns after `valid` are
@@ -30,10 +30,10 @@
 
 use core::fmt::{self, Write};
 
-use gaitclip::models::Model;
-use gaitclip::pipeline::Detector;
-use gaitclip::rate::SampleRate;
-use gaitclip::stride::Stride;
+use gaitclip::length::models::Model;
+use gaitclip::pipeline::detectors::Detector;
+use gaitclip::record::stride::Stride;
+use gaitclip::sensor::rate::SampleRate;
 
 use crate::imu_sampler::Counters;
 

@@ -19,14 +19,14 @@
 //!    [`crate::imu_sampler::Item::Woke`] with every period not sampled. The pipeline takes
 //!    that as a hole too long to bridge: detection restarts, the rest test and the foot
 //!    frame's bias and gravity come from the next rest (the frame is kept if gravity still
-//!    agrees, [`gaitclip::foot_frame`]), and the step the wake-up interrupted is reported as a
+//!    agrees, [`gaitclip::detect::foot_frame`]), and the step the wake-up interrupted is reported as a
 //!    gap stride (flagged, no length), not dropped; the strides after it are measured.
 //!
 //! Everything here is plain state, so the host tests (`tests-host/tests/sleep_policy.rs`)
 //! and the host model of the sleeping replay firmware use this very code.
 
 use gaitclip::mpu6050::{MotionThreshold, MotionThresholdUnit, MotionWake, WakeRate};
-use gaitclip::rate::SampleRate;
+use gaitclip::sensor::rate::SampleRate;
 
 use crate::imu_sampler::Item;
 

@@ -1,7 +1,7 @@
 //! Start-up calibration, as the user sees it.
 //!
 //! The gait core calibrates itself from the data: the first time the clip has rested for
-//! [`gaitclip::foot_frame::FIRST_FRAME_AFTER_MS`] it takes the gyroscope bias and the up axis
+//! [`gaitclip::detect::foot_frame::FIRST_FRAME_AFTER_MS`] it takes the gyroscope bias and the up axis
 //! from that rest, and it learns the forward axis from the first steps. No stride can be
 //! measured before that, so the board tells its user what it is waiting for:
 //!
@@ -13,10 +13,10 @@
 //!
 //! The core keeps refining all of it at every rest; this only reports progress.
 
-use gaitclip::detector::StepDetector;
+use gaitclip::detect::seam::StepDetector;
 use gaitclip::pipeline::Pipeline;
-use gaitclip::rate::SampleRate;
-use gaitclip::units::GyroScale;
+use gaitclip::sensor::rate::SampleRate;
+use gaitclip::sensor::units::GyroScale;
 
 /// How often to repeat the "hold still" message.
 pub const NAG_EVERY_MS: u32 = 2000;
@@ -103,7 +103,7 @@ impl Startup {
                         .gyro_bias()
                         .map(|c| (c as i64 * 10_000 / lsb_x10) as i32);
                     let gravity_mg = (f.gravity() as i64 * 1000
-                        / gaitclip::foot_frame::FOOT_LSB_PER_G as i64)
+                        / gaitclip::sensor::units::FOOT_LSB_PER_G as i64)
                         as i32;
                     let plausible = gyro_bias_mdps
                         .iter()

@@ -7,9 +7,10 @@
 
 use core::fmt::Write;
 
-use gaitclip::pipeline::{Config, HoleKind};
-use gaitclip::rate::SampleRate;
-use gaitclip::stride::Stride;
+use gaitclip::pipeline::config::Config;
+use gaitclip::pipeline::HoleKind;
+use gaitclip::record::stride::Stride;
+use gaitclip::sensor::rate::SampleRate;
 
 use crate::imu_sampler::Counters;
 use crate::serial_line;
@@ -31,7 +32,7 @@ pub struct StrideLog {
     strides: u32,
     /// Summed length of the strides that count in the distance (measured or estimated).
     distance_mm: u64,
-    /// Strides whose length is the estimate ([`gaitclip::estimate`]).
+    /// Strides whose length is the estimate ([`gaitclip::length::estimate`]).
     estimated: u32,
 }
 
@@ -68,7 +69,9 @@ impl StrideLog {
         if s.flags.counts_distance() {
             self.distance_mm += s.length_mm as u64;
         }
-        if s.flags.has(gaitclip::stride::StrideFlags::ESTIMATED) {
+        if s.flags
+            .has(gaitclip::record::stride::StrideFlags::ESTIMATED)
+        {
             self.estimated += 1;
         }
         defmt::println!(

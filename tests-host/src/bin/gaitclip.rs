@@ -4,14 +4,15 @@ use std::process::ExitCode;
 
 use anyhow::Context;
 use clap::{Parser, Subcommand};
-use gaitclip::models::Model;
-use gaitclip::phases::PhaseMethod;
-use gaitclip::pipeline::{Config, Detector};
+use gaitclip::detect::phases::PhaseMethod;
+use gaitclip::length::models::Model;
+use gaitclip::pipeline::config::Config;
+use gaitclip::pipeline::detectors::Detector;
 use gaitclip_host::eval;
 use gaitclip_host::trace::{Ranges, Trace};
 use gaitclip_host::{
     codegen, csv_trace, datasets, fit, fixtures, length_eval, matching, mcap_io, replay, tables,
-    train,
+    train, training_set,
 };
 
 #[derive(Parser)]
@@ -113,7 +114,7 @@ enum Cmd {
         /// The stance detector's thresholds for the detection tables, as
         /// `STD,IQR,GYRO` in (m/s²)², (m/s²)² and rad/s (default: the shipped 6,6,0.7).
         #[arg(long, value_name = "STD,IQR,GYRO", value_parser = stance_limits)]
-        stance: Option<gaitclip::stance::StanceLimits>,
+        stance: Option<gaitclip::detect::stance::StanceLimits>,
     },
     /// Compare the per-stride gait parameters (times, cadence, velocity, lift, turning,
     /// walking/running) with the references of dataset folders; prints Markdown tables.
@@ -129,7 +130,7 @@ enum Cmd {
         #[arg(default_value = "../../shared/datasets")]
         datasets: PathBuf,
         /// Output file.
-        #[arg(long, default_value = "../src/trained.rs")]
+        #[arg(long, default_value = "../src/length/trained.rs")]
         out: PathBuf,
     },
     /// Measure instructions per sample and stride (QEMU), firmware sizes and stacks, host
@@ -248,7 +249,7 @@ impl From<PhasesArg> for PhaseMethod {
     }
 }
 
-fn stance_limits(v: &str) -> Result<gaitclip::stance::StanceLimits, String> {
+fn stance_limits(v: &str) -> Result<gaitclip::detect::stance::StanceLimits, String> {
     let parts: Vec<f64> = v
         .split(',')
         .map(|x| x.trim().parse::<f64>().map_err(|e| format!("{x:?}: {e}")))
@@ -259,7 +260,7 @@ fn stance_limits(v: &str) -> Result<gaitclip::stance::StanceLimits, String> {
             .ok_or_else(|| format!("{x} is not a positive threshold"))
     };
     match parts[..] {
-        [std, iqr, gyro] => Ok(gaitclip::stance::StanceLimits {
+        [std, iqr, gyro] => Ok(gaitclip::detect::stance::StanceLimits {
             std_milli: milli(std)?,
             iqr_milli: milli(iqr)?,
             gyro_mradps: milli(gyro)?,
@@ -386,7 +387,7 @@ fn run(cli: Cli) -> anyhow::Result<()> {
             let detector = Detector::from_name(&detector).context("unknown detector")?;
             let model = match model.as_deref() {
                 Some(name) => Model::from_name(name).context("unknown model")?,
-                None => detector.length_model(gaitclip::pipeline::DEFAULT_MODEL),
+                None => detector.length_model(gaitclip::pipeline::config::DEFAULT_MODEL),
             };
             if detector
                 .own_model()
@@ -540,7 +541,7 @@ fn run(cli: Cli) -> anyhow::Result<()> {
                     }
                 }
                 side_by_side.push((d.name.clone(), tallies));
-                runs.extend(train::run_dataset(&d)?);
+                runs.extend(training_set::run_dataset(&d)?);
             }
             println!("The recordings as read (stamps, repeated samples, holes and what the core did with them):\n");
             print!("{}", tables::data_table(&loaded)?);
@@ -555,7 +556,7 @@ fn run(cli: Cli) -> anyhow::Result<()> {
                 .collect();
             println!("\nStep detectors side by side (cycle: every-pace stance instants, the default; stance: Huang's variance + IQR stance detector; lu: Lu's peak-valley detection):\n");
             print!("{}", tables::detectors_table(&rows));
-            let hyper = fit::hyper_from(&gaitclip::trained::HYPER);
+            let hyper = fit::hyper_from(&gaitclip::length::trained::HYPER);
             let mut by = Vec::new();
             for v in length_eval::Validation::ALL {
                 let pred = length_eval::predictions(&runs, &hyper, v)?;
@@ -568,7 +569,7 @@ fn run(cli: Cli) -> anyhow::Result<()> {
             println!(
                 "\nBest leave-one-dataset-out (mean of the two datasets' RMSE): `{}`; the firmware's default: `{}`.",
                 length_eval::lodo_best(lodo).name(),
-                gaitclip::pipeline::DEFAULT_MODEL.name()
+                gaitclip::pipeline::config::DEFAULT_MODEL.name()
             );
             println!(
                 "\nLeave-one-dataset-out in full (RMSE / MAE / bias; walked distance per trial):\n"
@@ -587,10 +588,14 @@ fn run(cli: Cli) -> anyhow::Result<()> {
             println!("\nWalked distance per trial, default model (datasets that give the walk's length; `ipol_gait_events`: 20 m nominal, the U-turn's extra path not counted):\n");
             print!(
                 "{}",
-                length_eval::walked_table(&runs, lodo_pred, gaitclip::pipeline::DEFAULT_MODEL)
+                length_eval::walked_table(
+                    &runs,
+                    lodo_pred,
+                    gaitclip::pipeline::config::DEFAULT_MODEL
+                )
             );
             if let Some(dir) = plots {
-                let model = gaitclip::pipeline::DEFAULT_MODEL;
+                let model = gaitclip::pipeline::config::DEFAULT_MODEL;
                 std::fs::create_dir_all(&dir)?;
                 let pairs = length_eval::pairs(&runs, lodo_pred, model);
                 let mut files = Vec::new();
@@ -611,7 +616,7 @@ fn run(cli: Cli) -> anyhow::Result<()> {
             }
         }
         Cmd::Train { datasets, out } => {
-            let runs = train::load_training(&datasets)?;
+            let runs = training_set::load_training(&datasets)?;
             let t = train::train(&runs)?;
             std::fs::write(&out, codegen::rust_source(&t))
                 .with_context(|| format!("writing {}", out.display()))?;
@@ -661,8 +666,9 @@ fn run(cli: Cli) -> anyhow::Result<()> {
             print!("{}", gaitclip_host::flag_costs::report(&datasets)?);
         }
         Cmd::Docs { datasets, check } => {
+            let exe = std::env::current_exe().context("the path of this binary")?;
             let pages =
-                gaitclip_host::docs::regenerate(&gaitclip_host::docs::docs_dir(), &datasets)?;
+                gaitclip_host::docs::regenerate(&gaitclip_host::docs::docs_dir(), &datasets, &exe)?;
             let mut stale = Vec::new();
             for p in &pages {
                 if p.stale.is_empty() {

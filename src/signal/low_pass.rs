@@ -13,7 +13,7 @@
 //! not only where a continuous-time design would warp little (the host test measures the gain
 //! at 3 Hz at 50–1000 Hz: 0.7070–0.7071).
 //!
-//! **Scaling.** Input: g/[`crate::foot_frame::FOOT_LSB_PER_G`] (`i16`, ±16 g). Output:
+//! **Scaling.** Input: g/[`crate::sensor::units::FOOT_LSB_PER_G`] (`i16`, ±16 g). Output:
 //! g/[`LOW_PASS_LSB_PER_G`] (`i32`), 16 times finer, so that thresholds of 0.01 g are not
 //! at the resolution of the input. State: input · 2¹² (`i32`; |state| < 2²⁸), `α` in Q16,
 //! products in `i64`.
@@ -26,7 +26,7 @@
 //! is the cascade's, rounded, so that the peak-valley detector can report the sample an
 //! extreme of the unfiltered signal belongs to (about 32 ms per section, 64 ms in all).
 
-use crate::rate::SampleRate;
+use crate::sensor::rate::SampleRate;
 
 /// Cut-off (−3 dB) of the cascade, mHz: Lu's 3 Hz.
 pub const CUTOFF_MHZ: u32 = 3_000;

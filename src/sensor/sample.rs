@@ -1,6 +1,6 @@
 //! One raw MPU6050 sample as it comes off the bus, and the sensor's full-scale ranges.
 
-use crate::units::{AccelScale, GyroScale};
+use crate::sensor::units::{AccelScale, GyroScale};
 
 /// Accelerometer full-scale range (register `ACCEL_CONFIG.AFS_SEL`).
 ///
@@ -295,4 +295,21 @@ const fn word(b: &[u8; SAMPLE_BYTES], i: usize) -> i16 {
 
 const fn rail(v: i16) -> bool {
     v == i16::MAX || v == i16::MIN
+}
+
+/// Where a sample fed to the tracker comes from: the sensor, or the pipeline's
+/// interpolation across a hole of lost samples ([`crate::pipeline::Pipeline::gap`]).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
+pub enum Origin {
+    /// Read from the sensor.
+    #[default]
+    Measured,
+    /// Interpolated across a hole short enough to measure through
+    /// ([`crate::pipeline::config::BRIDGE_MAX_MS`]): the stride is [`StrideFlags::BRIDGED`](crate::record::stride::StrideFlags::BRIDGED).
+    Bridged,
+    /// Interpolated across a longer hole ([`crate::pipeline::config::FILL_MAX_MS`]), so that the
+    /// stride's events outside the hole can still be found: in a movement the stride is a
+    /// [`StrideFlags::GAP`](crate::record::stride::StrideFlags::GAP) stride, in a stance only [`StrideFlags::BRIDGED`](crate::record::stride::StrideFlags::BRIDGED) (a foot at rest
+    /// is at rest either side of it).
+    Filled,
 }

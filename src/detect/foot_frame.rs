@@ -5,7 +5,7 @@
 //! them out from two facts of walking:
 //!
 //! - **At rest the accelerometer reads gravity alone.** The mean specific force of each rest
-//!   period (found by the orientation-free [`crate::rest`] test) is the up axis.
+//!   period (found by the orientation-free [`crate::detect::rest`] test) is the up axis.
 //! - **In a step the foot pitches about its medio-lateral axis.** The angular rate of a
 //!   movement is dominated by that axis: the principal eigenvector of `Σ ω ωᵀ` over the
 //!   movement, projected on the horizontal plane. Its sign comes from the order of the
@@ -24,10 +24,10 @@
 
 use nalgebra::{Matrix3, SymmetricEigen, Vector3};
 
-use crate::rate::SampleRate;
-use crate::rest::RestSums;
-use crate::sample::RawSample;
-use crate::units::{AccelScale, FootAccel, GyroScale};
+use crate::detect::rest::RestSums;
+use crate::sensor::rate::SampleRate;
+use crate::sensor::sample::RawSample;
+use crate::sensor::units::{AccelScale, FootAccel, GyroScale, FOOT_LSB_PER_G};
 
 /// A rest period whose gravity direction is further than this from the current up axis
 /// means the clip was moved: the frame starts again.
@@ -55,10 +55,6 @@ pub const STILL_GYRO_STD_MRADPS: u32 = 50;
 /// turns gravity; its mean rate is no bias. (Accelerometer noise turns the halves' means of a
 /// 250 ms block at 100 Hz by ≈ 0.001 rad, a third of this rate's 0.0025 rad.)
 pub const STILL_TILT_MRADPS: u32 = 20;
-/// Foot-frame accelerations are in units of g/[`FOOT_LSB_PER_G`] whatever the sensor's
-/// range: the counts of the ±16 g range.
-pub const FOOT_LSB_PER_G: i32 = 2048;
-
 /// cos(REMOUNT_DEG).
 const COS_REMOUNT: f32 = 0.906_307_8;
 /// Weight of a new rest period in the smoothed up axis and gravity.

@@ -25,7 +25,7 @@
 //!
 //! Integer and bounded: [`HISTORY`] pairs of `u32`.
 
-use crate::stride::{Stride, StrideFlags, MAX_STRIDE_MM};
+use crate::record::stride::{Stride, StrideFlags, MAX_STRIDE_MM};
 
 /// Measured strides the estimate is the mean of.
 pub const HISTORY: usize = 2;

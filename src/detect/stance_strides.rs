@@ -7,11 +7,11 @@
 //!  |---- stance -------|-- push-off --|----- swing -----|-- heel-strike --|
 //! ```
 //!
-//! Heel-off and foot-flat are the edges of the stances ([`crate::stance`]); toe-off and
-//! heel-strike come from Huang's splitter ([`crate::phases`]) run on the movement's
+//! Heel-off and foot-flat are the edges of the stances ([`crate::detect::stance`]); toe-off and
+//! heel-strike come from Huang's splitter ([`crate::detect::phases`]) run on the movement's
 //! foot-frame acceleration. A stride carries the ZUPT displacement of the movement
-//! ([`crate::zupt`]); the integer summaries of its acceleration phase by phase
-//! ([`crate::phase_stats`]), which the length models' features need, stay with the tracker
+//! ([`crate::detect::zupt`]); the integer summaries of its acceleration phase by phase
+//! ([`crate::detect::phase_stats`]), which the length models' features need, stay with the tracker
 //! ([`StrideTracker::stats`]: ten times the record's size, they need not travel with it);
 //! the pipeline fills in the length.
 //!
@@ -32,202 +32,26 @@
 //! followed the gap. A gap inside a stance that goes on after it costs nothing.
 //!
 //! Streaming and bounded: the only per-stride memory is the movement's foot-frame
-//! acceleration, a buffer of `M` samples of which at most [`MAX_MOVEMENT_MS`] are used
-//! ([`movement_samples`] holds that at a rate; a board with little RAM picks fewer); a longer
+//! acceleration, a buffer of `M` samples of which at most [`MAX_MOVEMENT_MS`](crate::detect::seam::MAX_MOVEMENT_MS) are used
+//! ([`movement_samples`](crate::detect::seam::movement_samples) holds that at a rate; a board with little RAM picks fewer); a longer
 //! movement is still closed at the next stance but flagged [`StrideFlags::TOO_LONG`] and split
 //! on what was kept.
 
 use heapless::Vec;
 
-use crate::detector::{Drain, Input, StepDetector};
-use crate::fixed::isqrt_u64;
-use crate::foot_frame::FOOT_LSB_PER_G;
-use crate::gait::GaitParameters;
-use crate::phase_stats::{StrideStats, CHANNELS};
-use crate::phases::{self, PhaseMethod};
-use crate::pipeline::Config;
-use crate::rate::SampleRate;
-use crate::rest::RestSums;
-use crate::sample::{Rails, RawSample};
-use crate::stance::{StanceDetector, StanceThresholds};
-use crate::units::{FootAccel, GyroScale};
-use crate::zupt::{Displacement, ZuptIntegrator};
-
-/// The longest movement (heel-off to foot-flat) kept for the phases, ms, at any rate: a
-/// walking movement lasts 0.5–1 s, a slow backward one 2 s. A longer one is closed at the next
-/// stance but flagged [`StrideFlags::TOO_LONG`]; its ZUPT length, integrated sample by sample,
-/// does not depend on the buffer.
-pub const MAX_MOVEMENT_MS: u32 = 5120;
-
-/// Movement buffer capacity that holds [`MAX_MOVEMENT_MS`] at `rate_hz`: 1 024 samples
-/// (6 KiB) at the boards' 200 Hz, 5 120 at 1 kHz. A board short of RAM picks fewer and
-/// flags longer movements sooner.
-pub const fn movement_samples(rate_hz: u32) -> usize {
-    (rate_hz as usize * MAX_MOVEMENT_MS as usize).div_ceil(1000)
-}
-
-/// Default capacity of the movement buffer: [`MAX_MOVEMENT_MS`] at the fastest supported
-/// rate (1 kHz), so that a pipeline made without naming one (the host's) sizes the buffer by
-/// time at any rate.
-pub const MAX_MOVEMENT_SAMPLES: usize = movement_samples(1000);
-/// A movement shorter than this is a wobble of a foot still on the ground, not a step.
-pub const MIN_MOVEMENT_MS: u32 = 150;
-/// At most this much of a stance counts toward the stride that leaves it: a user who stood
-/// for a minute before walking has a first stride of one step, not of a minute.
-pub const MAX_STANCE_IN_STRIDE_MS: u32 = 1000;
-
-/// The longest stride a person makes, mm: an elite sprinter's stride (two steps) is about
-/// 5 m. A model that says more was fed something else, and the stride is flagged
-/// [`StrideFlags::IMPLAUSIBLE`].
-pub const MAX_STRIDE_MM: u32 = 6000;
-
-/// Properties of a stride that qualify its length.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
-pub struct StrideFlags(pub u16);
-
-impl StrideFlags {
-    /// A sample of the movement sat at a rail and nothing put back what it lost: the length
-    /// is not measured (it is estimated, [`StrideFlags::ESTIMATED`]). Set by the stance
-    /// detector (Huang's method, which restores nothing) for any rail; the cycle detector
-    /// restores both sensors instead ([`StrideFlags::ACCEL_CLIPPED`],
-    /// [`StrideFlags::GYRO_CLIPPED`]).
-    pub const SATURATED: u16 = 1 << 0;
-    /// The movement lasted longer than the movement buffer holds ([`MAX_MOVEMENT_MS`], or
-    /// fewer samples on a board that picks a smaller buffer): not a walking stride.
-    pub const TOO_LONG: u16 = 1 << 1;
-    /// The stride starts from a stance longer than [`MAX_STANCE_IN_STRIDE_MS`]: the first
-    /// step after standing (informational).
-    pub const FROM_REST: u16 = 1 << 2;
-    /// The stance after the stride lasted longer than [`MAX_STANCE_IN_STRIDE_MS`], or the
-    /// recording ended in it: the last step before standing, often a half-stride.
-    pub const TO_REST: u16 = 1 << 3;
-    /// The heading changed by more than 45° over the movement: a turn.
-    pub const TURN: u16 = 1 << 4;
-    /// The phase splitter found no major peak-valley pair for a boundary: toe-off and
-    /// heel-strike are cluster centres, not measured events.
-    pub const PHASES_GUESSED: u16 = 1 << 5;
-    /// Samples were lost inside the stride's movement (a gap longer than
-    /// [`crate::pipeline::BRIDGE_MAX_MS`]): it has no length. Its events outside the hole
-    /// are measured; an event that falls inside the hole is unknown and set to the hole's
-    /// first missing sample (see [`crate::pipeline::Pipeline::gap`]).
-    pub const GAP: u16 = 1 << 6;
-    /// The length model gave more than [`MAX_STRIDE_MM`]; the length is clamped to it.
-    pub const IMPLAUSIBLE: u16 = 1 << 7;
-    /// A short hole of lost samples (at most [`crate::pipeline::BRIDGE_MAX_MS`], or a
-    /// longer one inside the stance) was bridged by interpolation: the stride and its
-    /// length stay valid (informational).
-    pub const BRIDGED: u16 = 1 << 8;
-    /// The gyroscope sat at a rail in the movement; the tilt the clipped rates lost was
-    /// restored from the end stance's gravity
-    /// ([`crate::zupt::ZuptIntegrator::displacement_restoring`]): the length stays
-    /// valid (informational).
-    pub const GYRO_CLIPPED: u16 = 1 << 9;
-    /// The accelerometer sat at a rail in the movement; what it lost was put back where it
-    /// was lost ([`crate::clipping`]): the length stays valid (informational).
-    pub const ACCEL_CLIPPED: u16 = 1 << 10;
-    /// The length was not measured (a flag in [`StrideFlags::INVALID`] says why) and is the
-    /// estimate from the strides before it at the same cadence ([`crate::estimate`]): it
-    /// counts in the distance.
-    pub const ESTIMATED: u16 = 1 << 11;
-    /// Flags that make a measured length untrustworthy: such a stride's length is estimated
-    /// instead ([`StrideFlags::ESTIMATED`]).
-    pub const INVALID: u16 = Self::SATURATED | Self::TOO_LONG | Self::GAP | Self::IMPLAUSIBLE;
-
-    /// True when no flag in [`StrideFlags::INVALID`] is set.
-    pub const fn valid(self) -> bool {
-        self.0 & Self::INVALID == 0
-    }
-
-    /// True when `flag` is set.
-    pub const fn has(self, flag: u16) -> bool {
-        self.0 & flag != 0
-    }
-
-    /// True when the stride's length counts in the distance: measured and valid, or
-    /// estimated.
-    pub const fn counts_distance(self) -> bool {
-        self.valid() || self.has(Self::ESTIMATED)
-    }
-}
-
-/// One stride. Indices are sample numbers since the pipeline started.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
-pub struct Stride {
-    /// Running stride number, from 0.
-    pub index: u32,
-    /// First sample (a foot-flat, or at most [`MAX_STANCE_IN_STRIDE_MS`] before heel-off).
-    pub start: u32,
-    /// End of stance: first sample of the movement.
-    pub heel_off: u32,
-    /// Toe-off: push-off ends, swing begins.
-    pub toe_off: u32,
-    /// Heel-strike: swing ends.
-    pub heel_strike: u32,
-    /// Foot-flat: the movement ends, the next stance begins (for the stance detector, the
-    /// same as `end`).
-    pub foot_flat: u32,
-    /// The stride's exclusive end, the next stride's start: the next foot-flat (stance
-    /// detector) or the next stance instant (cycle detector).
-    pub end: u32,
-    /// Length of the stride, mm, from the pipeline's length model
-    /// ([`crate::models`]); 0 until the pipeline sets it.
-    pub length_mm: u32,
-    /// Horizontal ZUPT displacement over the movement, µm (saturates at 4.29 km).
-    pub zupt_um: u32,
-    /// Height gained over the stride, mm (stairs, slopes).
-    pub climb_mm: i32,
-    /// Highest point of the sensor above its start over the movement, mm (gaitmap's
-    /// `max_sensor_lift`, [`crate::zupt::Displacement::max_lift_um`]); 0 without a ZUPT
-    /// trajectory (Lu's steps, a gap).
-    pub max_sensor_lift_mm: u16,
-    /// Heading change over the movement, centidegrees, counter-clockwise seen from above
-    /// positive (gaitmap's `turning_angle`, [`crate::zupt::ZuptIntegrator::heading_change_cdeg`]);
-    /// 0 without a ZUPT trajectory.
-    pub turning_angle_cdeg: i16,
-    /// Timing, velocity, cadence, walking or running: the pipeline's last stage
-    /// ([`crate::gait`]), once the length is set.
-    pub gait: GaitParameters,
-    /// Qualifiers.
-    pub flags: StrideFlags,
-}
-
-impl Stride {
-    /// Sets the length, clamped to [`MAX_STRIDE_MM`] and flagged
-    /// [`StrideFlags::IMPLAUSIBLE`] above it.
-    pub fn set_length_mm(&mut self, mm: u32) {
-        if mm > MAX_STRIDE_MM {
-            self.flags.0 |= StrideFlags::IMPLAUSIBLE;
-        }
-        self.length_mm = mm.min(MAX_STRIDE_MM);
-    }
-
-    /// Sets what the ZUPT trajectory of the movement gives: horizontal displacement, climb,
-    /// lift (rounded to mm, saturated) and the heading change.
-    pub fn set_trajectory(&mut self, d: &Displacement, turning_angle_cdeg: i16) {
-        self.zupt_um = d.horizontal_um.min(u32::MAX as u64) as u32;
-        self.climb_mm =
-            ((d.vertical_um + 500).div_euclid(1000)).clamp(i32::MIN as i64, i32::MAX as i64) as i32;
-        self.max_sensor_lift_mm = ((d.max_lift_um as u64 + 500) / 1000).min(u16::MAX as u64) as u16;
-        self.turning_angle_cdeg = turning_angle_cdeg;
-    }
-}
-
-/// Where a sample fed to the tracker comes from: the sensor, or the pipeline's
-/// interpolation across a hole of lost samples ([`crate::pipeline::Pipeline::gap`]).
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
-pub enum Origin {
-    /// Read from the sensor.
-    #[default]
-    Measured,
-    /// Interpolated across a hole short enough to measure through
-    /// ([`crate::pipeline::BRIDGE_MAX_MS`]): the stride is [`StrideFlags::BRIDGED`].
-    Bridged,
-    /// Interpolated across a longer hole ([`crate::pipeline::FILL_MAX_MS`]), so that the
-    /// stride's events outside the hole can still be found: in a movement the stride is a
-    /// [`StrideFlags::GAP`] stride, in a stance only [`StrideFlags::BRIDGED`] (a foot at rest
-    /// is at rest either side of it).
-    Filled,
-}
+use crate::detect::phase_stats::{StrideStats, CHANNELS};
+use crate::detect::phases::{self, PhaseMethod};
+use crate::detect::rest::RestSums;
+use crate::detect::seam::{
+    max_movement, DetectConfig, Drain, Input, StepDetector, MAX_MOVEMENT_SAMPLES,
+    MAX_STANCE_IN_STRIDE_MS, MIN_MOVEMENT_MS,
+};
+use crate::detect::stance::{StanceDetector, StanceThresholds};
+use crate::detect::zupt::ZuptIntegrator;
+use crate::record::stride::{Stride, StrideFlags};
+use crate::sensor::rate::SampleRate;
+use crate::sensor::sample::{Origin, Rails, RawSample};
+use crate::sensor::units::{FootAccel, GyroScale};
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 enum State {
@@ -606,7 +430,7 @@ impl<const M: usize> StrideTracker<M> {
         if self.movement.len() >= self.max_movement
             || self
                 .movement
-                .push([foot.up(), foot.forward(), magnitude_minus_g(foot)])
+                .push([foot.up(), foot.forward(), foot.magnitude_minus_g()])
                 .is_err()
         {
             self.flags |= StrideFlags::TOO_LONG;
@@ -665,7 +489,7 @@ impl<const M: usize> StrideTracker<M> {
             flags: StrideFlags(flags),
             ..Stride::default()
         };
-        held.set_trajectory(&d, self.zupt.heading_change_cdeg());
+        d.record_on(&mut held, self.zupt.heading_change_cdeg());
         if self.pending.is_none() {
             self.pending = Some(held);
         } else {
@@ -674,29 +498,8 @@ impl<const M: usize> StrideTracker<M> {
     }
 }
 
-/// Samples of a movement kept at `rate` in a buffer of `capacity`: [`MAX_MOVEMENT_MS`], at
-/// most the capacity.
-pub(crate) const fn max_movement(rate: SampleRate, capacity: usize) -> usize {
-    let n = rate.samples_in_ms(MAX_MOVEMENT_MS) as usize;
-    if n < capacity {
-        n
-    } else {
-        capacity
-    }
-}
-
-/// `|f| − g` of a foot-frame sample `[forward, left, up − g]` (g/2048), in g/2048,
-/// saturated to `i16`: the orientation-free magnitude channel of [`crate::phase_stats`].
-pub(crate) fn magnitude_minus_g(foot: FootAccel) -> i16 {
-    let [forward, left, up] = foot.0;
-    let up = up as i64 + FOOT_LSB_PER_G as i64;
-    let m2 = (forward as i64).pow(2) + (left as i64).pow(2) + up * up;
-    let m = isqrt_u64(m2 as u64) as i64 - FOOT_LSB_PER_G as i64;
-    m.clamp(i16::MIN as i64, i16::MAX as i64) as i16
-}
-
-/// Huang's method as a step detector ([`crate::detector::StepDetector`]): the variance + IQR
-/// stance detector ([`crate::stance`]) deciding about each sample, and the tracker above
+/// Huang's method as a step detector ([`crate::detect::seam::StepDetector`]): the variance + IQR
+/// stance detector ([`crate::detect::stance`]) deciding about each sample, and the tracker above
 /// turning its decisions into strides, stance to stance.
 #[derive(Clone, Debug)]
 pub struct StanceStrides<const M: usize = MAX_MOVEMENT_SAMPLES> {
@@ -714,7 +517,7 @@ pub struct StanceStrides<const M: usize = MAX_MOVEMENT_SAMPLES> {
 
 impl<const M: usize> StanceStrides<M> {
     /// The detector and tracker for data described by `config`.
-    pub const fn new(config: &Config) -> Self {
+    pub const fn new(config: &DetectConfig) -> Self {
         StanceStrides {
             stance: StanceDetector::new(StanceThresholds::with_limits(
                 config.rate,
@@ -848,7 +651,7 @@ mod tests {
         let rate = SampleRate::from_hz(RATE_HZ).unwrap();
         StrideTracker::sized(
             rate,
-            crate::sample::GyroRange::Dps2000.scale(),
+            crate::sensor::sample::GyroRange::Dps2000.scale(),
             PhaseMethod::Augmented,
         )
     }

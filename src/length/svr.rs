@@ -3,9 +3,9 @@
 //! A trained SVR predicts `y = Σᵢ αᵢ·exp(−γ‖z − zᵢ‖²) − ρ` where `z` is the z-scored
 //! feature vector (`(x − μ)/σ` with the training mean and deviation) and the `zᵢ` are the
 //! support vectors. The host trains it (`gaitclip train`, linfa-svm) and writes the numbers
-//! into [`crate::trained`]; here it is evaluated with integers only:
+//! into [`crate::length::trained`]; here it is evaluated with integers only:
 //!
-//! - features are Q16 ([`crate::features`]); `z = (x − μ)·σ⁻¹` with `σ⁻¹` in Q32, rounded
+//! - features are Q16 ([`crate::length::features`]); `z = (x − μ)·σ⁻¹` with `σ⁻¹` in Q32, rounded
 //!   to Q16 and clamped to ±256 (a deviation never seen in training);
 //! - support vectors are Q16 (`i32`), `‖z − zᵢ‖²` is Q32 in a `u64` (exact);
 //! - `γ‖z − zᵢ‖²` is Q32, `exp` comes from [`crate::fixed::exp_neg_q32`] (Q62, error
@@ -17,8 +17,8 @@
 //! training and test stride. Cost: one pass over the support vectors, `n_sv · n_features`
 //! multiply-adds and `n_sv` exponentials per stride.
 
-use crate::features::Features;
 use crate::fixed::exp_neg_q32;
+use crate::length::features::Features;
 
 /// Most features one SVR may use (keeps `‖z − zᵢ‖²` exact in a `u64`).
 pub const MAX_FEATURES: usize = 32;

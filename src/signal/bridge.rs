@@ -8,7 +8,7 @@
 //! middle, a cubic by ≈ 0.001 rad/s). Longer holes, which are filled only so that detection
 //! and the events outside them go on, use the straight line, which cannot overshoot.
 
-use crate::sample::RawSample;
+use crate::sensor::sample::RawSample;
 
 /// Sample `k` of the `n` periods from `a` (k = 0) to `b` (k = n), each axis on the straight
 /// line between them, rounded to the nearest count (halves up): within ½ count of the exact

@@ -1,6 +1,6 @@
 //! Rest detector, orientation-free: is the clip still?
 //!
-//! The foot frame ([`crate::foot_frame`]) needs rest periods before it knows which way is
+//! The foot frame ([`crate::detect::foot_frame`]) needs rest periods before it knows which way is
 //! up, so this test cannot use the frame. Over a sliding window of `W` samples (≈ 50 ms) the
 //! clip is at rest when both
 //! - the total variance of the (mean-filtered) specific force, `Σ_axes var(a)`, is under
@@ -11,8 +11,8 @@
 //! statistic depends on how the clip is mounted. Thresholds are set in physical units and
 //! converted to counts for the configured ranges; the window follows the sample rate.
 
-use crate::rate::SampleRate;
-use crate::units::{AccelScale, GyroScale};
+use crate::sensor::rate::SampleRate;
+use crate::sensor::units::{AccelScale, GyroScale};
 
 /// Window length in milliseconds (5 samples at 100 Hz, as SHOE uses).
 pub const WINDOW_MS: u32 = 50;
@@ -173,7 +173,7 @@ impl RestSums {
     }
 
     /// Adds one sample.
-    pub fn add(&mut self, s: &crate::sample::RawSample) {
+    pub fn add(&mut self, s: &crate::sensor::sample::RawSample) {
         if self.count >= Self::HALVING_AT {
             self.accel = self.accel.map(|v| v / 2);
             self.gyro = self.gyro.map(|v| v / 2);

@@ -1,6 +1,6 @@
 //! Stance (zero-velocity) detector after Huang et al. 2022, §2.3.2 and §4.
 //!
-//! Input: mean-filtered acceleration in the foot frame ([`crate::foot_frame`]), vertical
+//! Input: mean-filtered acceleration in the foot frame ([`crate::detect::foot_frame`]), vertical
 //! with gravity removed and sagittal, plus the angular-rate energy `|ω|²`.
 //!
 //! 1. **Deflation.** Each acceleration `x` becomes `x·|x|` (squared, sign kept): stance,
@@ -44,9 +44,9 @@
 //! trade is 0.002 of `ipol_gait_events` for 0.030 of `pyshoe_vicon`: no fixed threshold of
 //! this detector serves every pace.
 
-use crate::foot_frame::FOOT_LSB_PER_G;
-use crate::rate::SampleRate;
-use crate::units::{FootAccel, GyroScale};
+use crate::sensor::rate::SampleRate;
+use crate::sensor::units::FOOT_LSB_PER_G;
+use crate::sensor::units::{FootAccel, GyroScale};
 
 /// Half-widths of the three windows, ms (full windows 2·h + 1 samples: 30, 60, 120 ms).
 pub const HALF_WINDOW_MS: [u32; 3] = [15, 30, 60];
@@ -321,7 +321,7 @@ mod tests {
         let rate = SampleRate::from_hz(200).unwrap();
         StanceDetector::new(StanceThresholds::new(
             rate,
-            crate::sample::GyroRange::Dps2000.scale(),
+            crate::sensor::sample::GyroRange::Dps2000.scale(),
         ))
     }
 
@@ -342,7 +342,7 @@ mod tests {
     fn windows_are_centred_and_the_answer_waits_for_the_largest() {
         let t = StanceThresholds::new(
             SampleRate::from_hz(200).unwrap(),
-            crate::sample::GyroRange::Dps2000.scale(),
+            crate::sensor::sample::GyroRange::Dps2000.scale(),
         );
         assert_eq!(t.half, [3, 6, 12]);
         assert_eq!(t.delay(), 12);

@@ -1,7 +1,7 @@
 //! What a sensor at its rail lost, and putting it back.
 //!
-//! A reading at a rail ([`crate::sample::AxisRails`]) says only that the true value lay at
-//! or beyond it. The strapdown integration of a stride ([`crate::zupt`]) then misses what lay
+//! A reading at a rail ([`crate::sensor::sample::AxisRails`]) says only that the true value lay at
+//! or beyond it. The strapdown integration of a stride ([`crate::detect::zupt`]) then misses what lay
 //! beyond: a gyro's lost rotation tilts the level frame for the rest of the movement, an
 //! accelerometer's lost specific force is a step in the velocity from the clipped sample on.
 //! Both are put back, from two independent pieces of evidence:
@@ -32,7 +32,7 @@
 // Three parallel per-axis arrays are indexed together throughout.
 #![allow(clippy::needless_range_loop)]
 
-use crate::sample::AxisRails;
+use crate::sensor::sample::AxisRails;
 
 /// The parabola's area above the rail of a clipped run of `run` samples entered and left with
 /// the slopes `slope_in` and `slope_out` (counts per sample): `(s_in + s_out)·L³ / (12·(L + 2))`
@@ -295,7 +295,7 @@ impl AccelRun {
 /// loses force along; per stride the velocity steps of the reconstructed runs and the
 /// directions of the samples whose loss the residual will give.
 ///
-/// Units are the integrator's ([`crate::zupt::ZuptIntegrator`]): velocity in
+/// Units are the integrator's ([`crate::detect::zupt::ZuptIntegrator`]): velocity in
 /// accelerometer counts·2⁸ summed over samples, doubled position in those summed again.
 /// Range: movements up to 2¹⁶ samples, with any number of clipped samples in them (sums
 /// saturate rather than wrap). ≈ 200 bytes: three of these ride in every cycle detector.

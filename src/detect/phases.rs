@@ -191,7 +191,7 @@ pub fn split<const N: usize>(
 }
 
 fn find_extremes<const N: usize>(movement: &[[i16; N]], out: &mut Vec<Extreme, MAX_EXTREMES>) {
-    let min = MIN_EXTREME_MG * crate::foot_frame::FOOT_LSB_PER_G / 1000;
+    let min = MIN_EXTREME_MG * crate::sensor::units::FOOT_LSB_PER_G / 1000;
     let len = movement.len();
     for axis in [VERTICAL, SAGITTAL] {
         let a = axis as usize;

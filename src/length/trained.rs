@@ -33,11 +33,11 @@
 //! | `lu_fuzzy` | 35.11 |
 //! | `scarlett` | 38.20 |
 
-use crate::models::{Model, ModelParams};
-use crate::svr::{Boosted, Svr};
+use crate::length::models::{Model, ModelParams};
+use crate::length::svr::{Boosted, Svr};
 
 /// The model with the best leave-one-dataset-out score: the pipeline's default
-/// ([`crate::pipeline::DEFAULT_MODEL`]).
+/// ([`crate::pipeline::config::DEFAULT_MODEL`]).
 pub const LODO_BEST: Model = Model::Zupt;
 
 /// The SVR hyper-parameters `[C, γ, ε (m)]` chosen by cross-validation, for push-off,

@@ -3,9 +3,9 @@
 //! The stride stage keeps the movement (heel-off to foot-flat) in a buffer only until its
 //! phases are split; what the length models need of it is a handful of sums per phase and
 //! per signal, which this module takes. They are exact (integer) and small, so a stride
-//! record carries them to the feature stage ([`crate::features`]) without the buffer.
+//! record carries them to the feature stage ([`crate::length::features`]) without the buffer.
 //!
-//! Signals, all in g/2048 (the foot frame's [`crate::foot_frame::FOOT_LSB_PER_G`]):
+//! Signals, all in g/2048 (the foot frame's [`crate::sensor::units::FOOT_LSB_PER_G`]):
 //! vertical (gravity removed), sagittal (forward), and the magnitude of the specific force
 //! minus 1 g (orientation-free: what a phone's step-length models call `|a|`).
 

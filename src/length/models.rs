@@ -28,15 +28,15 @@
 //! Every closed-form model is linear in at most four fixed-point basis terms
 //! ([`basis`]); `gaitclip train` fits their coefficients by least squares (the fixed
 //! constants of Ho and of Lu's rule base stay as published, a gain `G` absorbs units) and
-//! writes them with the SVRs into [`crate::trained`]. Step models predict a step; fitted on
+//! writes them with the SVRs into [`crate::length::trained`]. Step models predict a step; fitted on
 //! strides, their constant simply doubles.
 
-use crate::features::{self, Features};
+use crate::detect::phase_stats::{Channel, Segment, StrideStats};
 use crate::fixed::{div_round_i128, root_q16, tenth_root_q16, Q16_ONE};
-use crate::fuzzy;
-use crate::phase_stats::{Channel, Segment, StrideStats};
-use crate::stride::{Stride, StrideFlags};
-use crate::svr::{Boosted, Svr};
+use crate::length::features::{self, Features};
+use crate::length::fuzzy;
+use crate::length::svr::{Boosted, Svr};
+use crate::record::stride::{StepAmplitude, Stride, StrideFlags};
 
 /// Number of models.
 pub const MODELS: usize = 14;
@@ -312,16 +312,26 @@ pub struct LengthChain {
     /// Trained coefficients and SVRs.
     pub params: &'static ModelParams<'static>,
     /// Sample rate (the features' durations).
-    pub rate: crate::rate::SampleRate,
+    pub rate: crate::sensor::rate::SampleRate,
 }
 
 impl LengthChain {
-    /// Fills in `s`'s length from its features (`stats`: its phase statistics, if still
-    /// kept); a gap stride keeps none.
+    /// Fills in `s`'s length: a peak-valley step (`step`, Lu's detector) by Lu's chain
+    /// ([`crate::length::lu::lu_chain_um`]); a stride from its features (`stats`: its phase
+    /// statistics, if still kept); a gap stride keeps none.
     // Not inlined: the per-stride work stays out of the per-sample frame (stack), and
     // `gaitclip cost` counts it apart from the sample path.
     #[inline(never)]
-    pub fn measure(&self, s: &mut Stride, stats: Option<&StrideStats>) {
+    pub fn measure(
+        &self,
+        s: &mut Stride,
+        stats: Option<&StrideStats>,
+        step: Option<StepAmplitude>,
+    ) {
+        if let Some(step) = step {
+            s.set_length_mm(um_to_mm(crate::length::lu::lu_chain_um(&step, self.rate)));
+            return;
+        }
         if s.flags.has(StrideFlags::GAP) {
             // No length across a gap; `length_mm` stays 0.
             return;

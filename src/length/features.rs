@@ -1,7 +1,7 @@
 //! Per-phase features of a stride (Huang §2.4.2, Table 2), in Q16 fixed point.
 //!
 //! For each of the four segments (push-off, swing, heel-strike, the whole movement) and each
-//! of the three signals (vertical, sagittal, magnitude; see [`crate::phase_stats`]):
+//! of the three signals (vertical, sagittal, magnitude; see [`crate::detect::phase_stats`]):
 //!
 //! | stat | value | unit |
 //! |---|---|---|
@@ -22,11 +22,11 @@
 //! 1.53e−5). `tests-host/tests/lengths.rs` checks every feature against f64 within 1 LSB.
 //! Empty segments give zeros. Work is per stride, not per sample.
 
+use crate::detect::phase_stats::{Channel, ChannelStats, Segment, StrideStats, CHANNELS, SEGMENTS};
 use crate::fixed::{div_round_i128, iroot_u128, root_q16, Q16_ONE};
-use crate::foot_frame::FOOT_LSB_PER_G;
-use crate::phase_stats::{Channel, ChannelStats, Segment, StrideStats, CHANNELS, SEGMENTS};
-use crate::rate::SampleRate;
-use crate::stride::Stride;
+use crate::record::stride::Stride;
+use crate::sensor::rate::SampleRate;
+use crate::sensor::units::FOOT_LSB_PER_G;
 
 /// Statistics taken of every signal in every segment.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -152,7 +152,7 @@ impl Features {
     }
 
     /// The features of `stride`, whose movement `stats` summarise
-    /// ([`crate::stride::StrideTracker::stats`]), recorded at `rate`.
+    /// ([`crate::detect::stance_strides::StrideTracker::stats`]), recorded at `rate`.
     pub fn of(stride: &Stride, stats: &StrideStats, rate: SampleRate) -> Features {
         let mut f = [0i64; COUNT];
         for seg in Segment::ALL {

@@ -1,6 +1,6 @@
 //! Lu et al. 2020's peak-valley step detection (§2), streaming and in integers.
 //!
-//! A second step detector beside the stance-based one ([`crate::stance`]): it looks only at
+//! A second step detector beside the stance-based one ([`crate::detect::stance`]): it looks only at
 //! the vertical acceleration of the foot frame with gravity removed, and counts a step for
 //! every *peak followed by a valley* that survives Lu's rules against over-counting.
 //!
@@ -9,7 +9,7 @@
 //!                                      ─ neighbouring difference ─ peak-valley sequence ─ Step
 //! ```
 //!
-//! 1. **Low-pass** ([`crate::low_pass`]): −3 dB at 3 Hz at every sample rate.
+//! 1. **Low-pass** ([`crate::signal::low_pass`]): −3 dB at 3 Hz at every sample rate.
 //! 2. **Extremes**: a peak is a local maximum above zero, a valley a local minimum below
 //!    zero (negative peaks and positive valleys are ignored); on a plateau, its last sample.
 //!    None is taken in the filter's first delay after a start or a gap (it is settling).
@@ -59,15 +59,11 @@
 
 use heapless::Vec;
 
-use crate::detector::{Drain, Input, StepDetector};
-use crate::fixed::{div_round_i128, root_q16, Q16_ONE};
-use crate::fuzzy;
-use crate::low_pass::{LowPass, LOW_PASS_LSB_PER_G};
-use crate::models::{um_to_mm, LengthChain, Model};
-use crate::phase_stats::StrideStats;
-use crate::pipeline::Config;
-use crate::rate::SampleRate;
-use crate::stride::{Stride, StrideFlags};
+use crate::detect::phase_stats::StrideStats;
+use crate::detect::seam::{DetectConfig, Drain, Input, StepDetector};
+use crate::record::stride::{StepAmplitude, Stride, StrideFlags};
+use crate::sensor::rate::SampleRate;
+use crate::signal::low_pass::{LowPass, LOW_PASS_LSB_PER_G};
 
 const fn g_milli(mg: i32) -> i32 {
     // Rounded to the nearest low-pass unit (g/32 768).
@@ -725,64 +721,51 @@ impl PeakValleyDetector {
     }
 }
 
-/// Lu's whole chain on one of the peak-valley detector's steps
-/// ([`PeakValleySteps`]), with the paper's constants and no training:
-/// `D` = peak − valley (eq. 11) and the step frequency `f` give the fuzzy `k` over the
-/// paper's universes ([`fuzzy::D_UNIVERSE_Q16`], [`fuzzy::F_UNIVERSE_Q16`]), and Weinberg's
-/// `k·(a_max − a_min)^¼` (eq. 6) is taken with the step's own peak and valley as `a_max`
-/// and `a_min`. Returns the foot's stride, µm.
-///
-/// On a foot the detector sees one peak-valley pair per stride of that foot, so the
-/// walker's step frequency is twice the pairs' (`f = 2·rate/period`), and the foot's
-/// stride is two of the walker's steps: the stride is `2·k·D^¼`. The first step of a walk
-/// has no period; it takes `f` at the bottom of the universe (1 Hz), as a walk starts slowly.
-pub fn lu_chain_um(step: &Step, rate: SampleRate) -> i64 {
-    // D in g, Q16: the low-pass unit is g/32 768 = 2⁻¹⁵ g.
-    let d_q16 = (step.difference().max(0) as i64) << 1;
-    let f_q16 = if step.period == 0 {
-        fuzzy::F_UNIVERSE_Q16.0
-    } else {
-        // 2 · rate(mHz)/1000 / period, Hz, Q16.
-        div_round_i128(
-            2 * rate.millihertz() as i128 * Q16_ONE as i128,
-            1000 * step.period as i128,
-        ) as i64
-    };
-    let k = fuzzy::lu_k_q16(f_q16, fuzzy::F_UNIVERSE_Q16, d_q16, fuzzy::D_UNIVERSE_Q16);
-    let root = root_q16(d_q16 as u64, 4) as i64;
-    // 2 · k · D^¼, Q32 → µm.
-    div_round_i128(2 * k as i128 * root as i128 * 1_000_000, 1i128 << 32) as i64
-}
-
-/// Lu's detector as a step detector ([`crate::detector::StepDetector`]): fed the foot frame's
-/// vertical acceleration, each of its steps becomes a stride record measured by Lu's own
-/// chain ([`lu_chain_um`]) whatever the configured model.
+/// Lu's detector as a step detector ([`crate::detect::seam::StepDetector`]): fed the foot frame's
+/// vertical acceleration, each of its steps becomes a stride record, and its amplitude
+/// ([`StepDetector::step`]) what the length stage measures it with: Lu's own chain
+/// ([`crate::length::lu::lu_chain_um`]) whatever the configured model.
 #[derive(Clone, Debug)]
 pub struct PeakValleySteps {
     peaks: PeakValleyDetector,
-    rate: SampleRate,
     /// A step released while filling a hole with no call to report it from.
     held: Option<Stride>,
+    /// The amplitudes of the last two steps released, by step index parity, with the index
+    /// they belong to.
+    amplitudes: [(u32, StepAmplitude); 2],
 }
 
 impl PeakValleySteps {
     /// The detector for data described by `config`.
-    pub const fn new(config: &Config) -> Self {
+    pub const fn new(config: &DetectConfig) -> Self {
         PeakValleySteps {
             peaks: PeakValleyDetector::new(config.rate),
-            rate: config.rate,
             held: None,
+            amplitudes: [(
+                u32::MAX,
+                StepAmplitude {
+                    peak_to_valley: 0,
+                    period: 0,
+                },
+            ); 2],
         }
     }
 
-    /// One step as a stride record, measured by Lu's chain.
+    /// One step as a stride record (its length the length stage's), its amplitude kept.
     #[inline(never)]
-    pub fn measure_step(&self, step: Step) -> Stride {
+    pub fn record_step(&mut self, step: Step) -> Stride {
+        self.amplitudes[(step.index & 1) as usize] = (
+            step.index,
+            StepAmplitude {
+                peak_to_valley: step.difference(),
+                period: step.period,
+            },
+        );
         let mut flags = StrideFlags::PHASES_GUESSED;
         if step.period == 0 {
             flags |= StrideFlags::FROM_REST;
         }
-        let mut s = Stride {
+        Stride {
             index: step.index,
             start: step.peak.index,
             heel_off: step.peak.index,
@@ -792,15 +775,11 @@ impl PeakValleySteps {
             end: step.valley.index,
             flags: StrideFlags(flags),
             ..Stride::default()
-        };
-        s.set_length_mm(um_to_mm(lu_chain_um(&step, self.rate)));
-        s
+        }
     }
 }
 
 impl StepDetector for PeakValleySteps {
-    const OWN_MODEL: Option<Model> = Some(Model::LuFuzzy);
-
     fn delay(&self, filter_delay: u32) -> u32 {
         filter_delay + self.peaks.filter_delay()
     }
@@ -815,7 +794,7 @@ impl StepDetector for PeakValleySteps {
             *out = self
                 .peaks
                 .process(at, x.foot.up())
-                .map(|s| self.measure_step(s));
+                .map(|s| self.record_step(s));
         } else {
             self.peaks.feed(at, x.foot.up());
         }
@@ -836,15 +815,17 @@ impl StepDetector for PeakValleySteps {
         if let Some(s) = self.held.take() {
             return Some(s);
         }
-        self.peaks.finish().map(|s| self.measure_step(s))
+        self.peaks.finish().map(|s| self.record_step(s))
     }
 
     fn stats(&self, _: u32) -> Option<&StrideStats> {
         None
     }
 
-    /// Measured as it was released, by Lu's chain.
-    fn measure(&self, _: &mut Stride, _: &LengthChain) {}
+    fn step(&self, index: u32) -> Option<StepAmplitude> {
+        let (at, a) = self.amplitudes[(index & 1) as usize];
+        (at == index).then_some(a)
+    }
 
     fn dropped(&self) -> u32 {
         self.peaks.dropped()

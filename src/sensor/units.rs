@@ -1,10 +1,12 @@
 //! Units the stages compute in, as types: a sensor's scale (counts per g, per °/s) apart
 //! from the register values that set it, and the foot-frame acceleration every stage after
 //! the foot frame reads. The stages take these, not the MPU6050's range enums
-//! ([`crate::sample::AccelRange::scale`], [`crate::sample::GyroRange::scale`] convert), so
+//! ([`crate::sensor::sample::AccelRange::scale`], [`crate::sensor::sample::GyroRange::scale`] convert), so
 //! another sensor needs only its own scale.
 
-use crate::foot_frame::FOOT_LSB_PER_G;
+/// Foot-frame accelerations are in units of g/`FOOT_LSB_PER_G` whatever the sensor's range:
+/// 2048 counts per g, the MPU6050's ±16 g scale, so that ±16 g fits an `i16`.
+pub const FOOT_LSB_PER_G: i32 = 2048;
 
 /// An accelerometer's scale: counts per g.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -67,6 +69,16 @@ impl GyroScale {
 pub struct FootAccel(pub [i16; 3]);
 
 impl FootAccel {
+    /// `|f| − g` of `[forward, left, up − g]` (g/2048), in g/2048, saturated to `i16`: the
+    /// orientation-free magnitude channel of the phase statistics.
+    pub fn magnitude_minus_g(self) -> i16 {
+        let [forward, left, up] = self.0;
+        let up = up as i64 + FOOT_LSB_PER_G as i64;
+        let m2 = (forward as i64).pow(2) + (left as i64).pow(2) + up * up;
+        let m = crate::fixed::isqrt_u64(m2 as u64) as i64 - FOOT_LSB_PER_G as i64;
+        m.clamp(i16::MIN as i64, i16::MAX as i64) as i16
+    }
+
     /// From mg, rounded (half away from zero) and saturated to the ±16 g the unit holds.
     pub const fn from_milli_g(mg: [i32; 3]) -> Self {
         let mut out = [0i16; 3];

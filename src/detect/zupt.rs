@@ -13,12 +13,13 @@
 //! position as `i64` sums. Ranges: movements up to 2³¹ samples do not overflow (velocity
 //! < 2²³·n, doubled position < 2²⁴·n²; `i64` holds n = 2²⁰ with margin).
 
-use crate::clipping::{ClippedAccel, RailRun};
+use crate::detect::clipping::{ClippedAccel, RailRun};
+use crate::detect::rest::RestSums;
 use crate::fixed::{atan2_cdeg, div_round_i128, isqrt_u64, QuatQ30};
-use crate::rate::SampleRate;
-use crate::rest::RestSums;
-use crate::sample::{Rails, RawSample};
-use crate::units::GyroScale;
+use crate::record::stride::Stride;
+use crate::sensor::rate::SampleRate;
+use crate::sensor::sample::{Rails, RawSample};
+use crate::sensor::units::GyroScale;
 
 /// π · 2³².
 const PI_Q32: u128 = 13_493_037_705;
@@ -99,6 +100,19 @@ pub struct Displacement {
     pub max_lift_um: u32,
 }
 
+impl Displacement {
+    /// Writes what this trajectory gives into `s`: horizontal displacement, climb, lift
+    /// (rounded to mm, saturated) and the heading change `turning_angle_cdeg`.
+    pub fn record_on(&self, s: &mut Stride, turning_angle_cdeg: i16) {
+        let d = self;
+        s.zupt_um = d.horizontal_um.min(u32::MAX as u64) as u32;
+        s.climb_mm =
+            ((d.vertical_um + 500).div_euclid(1000)).clamp(i32::MIN as i64, i32::MAX as i64) as i32;
+        s.max_sensor_lift_mm = ((d.max_lift_um as u64 + 500) / 1000).min(u16::MAX as u64) as u16;
+        s.turning_angle_cdeg = turning_angle_cdeg;
+    }
+}
+
 /// Strapdown integrator for one movement.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct ZuptIntegrator {
@@ -119,7 +133,7 @@ pub struct ZuptIntegrator {
     clipped_c2: i64,
     /// Per gyro axis, the rotation lost at its rail.
     rail_runs: [RailRun; 3],
-    /// What the accelerometer lost at its rails ([`crate::clipping`]).
+    /// What the accelerometer lost at its rails ([`crate::detect::clipping`]).
     accel: ClippedAccel,
     /// The doubled vertical position every `lift_every` samples (sample `(k + 1)·lift_every`
     /// at `lift[k]`), `lift_len` of them; `lift_countdown` samples to the next.
@@ -257,7 +271,7 @@ impl ZuptIntegrator {
 
     /// [`ZuptIntegrator::displacement_to`], with what the rails lost put back: the
     /// accelerometer's lost force as velocity steps where it was lost
-    /// ([`crate::clipping::ClippedAccel`]), then the gyro's lost tilt.
+    /// ([`crate::detect::clipping::ClippedAccel`]), then the gyro's lost tilt.
     ///
     /// **Accelerometer.** Clipped runs of two samples or more are reconstructed from their
     /// shape; single clipped samples take their share of the end-velocity residual (against
@@ -314,7 +328,7 @@ impl ZuptIntegrator {
         &self,
         position: &mut [i64; 3],
         end_gravity_q8: [i64; 3],
-        rails: &[crate::sample::AxisRails; 3],
+        rails: &[crate::sensor::sample::AxisRails; 3],
     ) {
         let r = self.attitude.matrix();
         let level: [i128; 3] = r.map(|row| {

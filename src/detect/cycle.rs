@@ -4,7 +4,7 @@
 //!
 //! **Why not a threshold.** A walking foot at rest reads almost nothing; a jogging foot never
 //! drops below ≈ 0.5–1 rad/s on the ground. No fixed threshold on a stance statistic serves
-//! both (Huang's [`crate::stance`] detector merges strides at speed; SHOE's own thresholds
+//! both (Huang's [`crate::detect::stance`] detector merges strides at speed; SHOE's own thresholds
 //! fail one pace or the other). What every pace shares is the shape of the cycle: each
 //! cycle's stillest moment lies far below the swings either side of it.
 //!
@@ -47,17 +47,19 @@
 
 use heapless::Vec;
 
-use crate::detector::{Drain, Input, StepDetector};
+use crate::detect::foot_frame::FootFrameEstimator;
+use crate::detect::phase_stats::{StrideStats, CHANNELS};
+use crate::detect::phases::{self, PhaseMethod};
+use crate::detect::seam::MAX_STANCE_IN_STRIDE_MS;
+use crate::detect::seam::{DetectConfig, Drain, Input, StepDetector};
+use crate::detect::zupt::{RollingContact, ZuptIntegrator};
 use crate::fixed::{isqrt_u64, QuatQ30};
-use crate::foot_frame::{FootFrameEstimator, FOOT_LSB_PER_G};
-use crate::phase_stats::{StrideStats, CHANNELS};
-use crate::phases::{self, PhaseMethod};
-use crate::pipeline::Config;
-use crate::rate::SampleRate;
-use crate::sample::{Rails, RawSample};
-use crate::stride::{magnitude_minus_g, Origin, Stride, StrideFlags, MAX_STANCE_IN_STRIDE_MS};
-use crate::units::{AccelScale, FootAccel, GyroScale};
-use crate::zupt::{RollingContact, ZuptIntegrator};
+use crate::record::stride::{Stride, StrideFlags};
+use crate::sensor::rate::SampleRate;
+use crate::sensor::sample::Origin;
+use crate::sensor::sample::{Rails, RawSample};
+use crate::sensor::units::FOOT_LSB_PER_G;
+use crate::sensor::units::{AccelScale, FootAccel, GyroScale};
 
 /// Energy window, ms (5 samples at 100 Hz, as SHOE's; 11 at 200 Hz).
 pub const ENERGY_WINDOW_MS: u32 = 50;
@@ -115,7 +117,7 @@ pub struct CycleConfig {
     pub spacing: u32,
     /// See [`MAX_STANCE_IN_STRIDE_MS`].
     pub max_stance: u32,
-    /// Samples of [`crate::stride::MAX_MOVEMENT_MS`].
+    /// Samples of [`crate::detect::seam::MAX_MOVEMENT_MS`].
     pub max_movement: u32,
     /// Gyro counts² → Q40 of (rad/s)²/σω².
     k_w: u64,
@@ -129,7 +131,7 @@ pub struct CycleConfig {
     integrator: ZuptIntegrator,
     /// Where each axis clips.
     pub rails: Rails,
-    /// Whether the accelerometer's loss at its rails is put back ([`Config::restore_accel`]).
+    /// Whether the accelerometer's loss at its rails is put back ([`Config::restore_accel`](crate::pipeline::config::Config::restore_accel)).
     pub restore_accel: bool,
 }
 
@@ -170,7 +172,7 @@ impl CycleConfig {
             confirm: rate.samples_in_ms(CONFIRM_MS),
             spacing: rate.samples_in_ms(MIN_SPACING_MS),
             max_stance: rate.samples_in_ms(MAX_STANCE_IN_STRIDE_MS),
-            max_movement: rate.samples_in_ms(crate::stride::MAX_MOVEMENT_MS),
+            max_movement: rate.samples_in_ms(crate::detect::seam::MAX_MOVEMENT_MS),
             k_w: k_w as u64,
             k_a: k_a as u64,
             rolling: RollingContact::new(sensor_height_um, rate, gyro),
@@ -312,7 +314,7 @@ pub struct CycleDetector<const M: usize> {
     /// (`movement[0]` is sample `mv_origin`), less the samples of a slow swing's dip that
     /// were taken for a stance (`mv_gap`: buffer position and samples skipped there).
     movement: Vec<[i16; CHANNELS], M>,
-    /// Samples of a movement kept ([`crate::stride::MAX_MOVEMENT_MS`] at the rate, at most
+    /// Samples of a movement kept ([`crate::detect::seam::MAX_MOVEMENT_MS`] at the rate, at most
     /// `M`).
     max_movement: usize,
     mv_origin: u32,
@@ -336,7 +338,7 @@ const fn per_window(q16: u64, w: u32) -> u64 {
 
 impl<const M: usize> CycleDetector<M> {
     /// The detector for data described by `config`.
-    pub const fn new(config: &Config) -> Self {
+    pub const fn new(config: &DetectConfig) -> Self {
         let mut cfg = CycleConfig::new(
             config.rate,
             config.accel,
@@ -391,7 +393,7 @@ impl<const M: usize> CycleDetector<M> {
     }
 
     /// The phase statistics of stride `index` while kept (see
-    /// [`crate::stride::StrideTracker::stats`]).
+    /// [`crate::detect::stance_strides::StrideTracker::stats`]).
     pub fn stats(&self, index: u32) -> Option<&StrideStats> {
         let (at, stats) = &self.stats[(index & 1) as usize];
         (*at == index).then_some(stats)
@@ -552,7 +554,7 @@ impl<const M: usize> CycleDetector<M> {
             // Full: what is lost is counted when the stride closes (too long).
             let _ = self
                 .movement
-                .push([foot.up(), foot.forward(), magnitude_minus_g(foot)]);
+                .push([foot.up(), foot.forward(), foot.magnitude_minus_g()]);
         }
         self.peak = self.peak.max(t);
         self.peak_since_cand = self.peak_since_cand.max(t);
@@ -919,7 +921,7 @@ impl<const M: usize> CycleDetector<M> {
         };
         // No displacement across a hole.
         if cur.broken.is_none() {
-            stride.set_trajectory(&d, c.snap.heading_change_cdeg());
+            d.record_on(&mut stride, c.snap.heading_change_cdeg());
         }
         Some(stride)
     }
