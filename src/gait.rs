@@ -27,7 +27,7 @@
 //! β > 0.5, running β < 0.5; Novacheck, "The biomechanics of running", Gait & Posture 7, 1998:
 //! stance ≈ 62 % of the cycle walking, ≈ 39 % running, ≈ 36 % sprinting). The threshold is
 //! that physical boundary, not a value fitted to a dataset; how the IMU's events place it
-//! against Vicon speeds is in the README.
+//! against Vicon speeds is in docs/accuracy.md.
 //!
 //! Integer throughout: times in ms from sample counts ([`SampleRate::ms_of_samples`]),
 //! ratios and velocity by rounded integer division.

@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# Measures what gaitclip costs and prints it as Markdown (the README's cost tables):
+# Measures what gaitclip costs and prints it as Markdown (docs/cost.md's tables):
 # instructions per sample and per stride on the emulated Cortex-M4 and M0 (QEMU with the
 # qemu-insn-count plugin), flash / static RAM / stack of every firmware build, and host
 # replay throughput (criterion) next to gaitmap's pipeline on the same real trace.
@@ -34,6 +34,21 @@ report=$(cargo run --release --quiet --bin gaitclip -- cost \
   --datasets "$datasets")
 
 cpu=$(sed -n 's/^model name[[:space:]]*: //p' /proc/cpuinfo | head -1)
+out=$(mktemp)
+{
 echo "Measured on $(date -u +%Y-%m-%d) on ${cpu:-$(uname -m)} ($(nproc) cores, $(uname -m)); $(rustc --version | cut -d' ' -f1-2); $(qemu-system-arm --version | head -1 | sed 's/ (.*//'); $(python3 --version)."
 echo
 echo "$report"
+} > "$out"
+cat "$out"
+# The tables go into docs/cost.md between its markers: re-measuring is this command, not an
+# edit. (They hold times, so no staleness test checks them; docs/cost.md says when.)
+python3 - "$root/docs/cost.md" "$out" <<'PY'
+import sys
+page, out = sys.argv[1], open(sys.argv[2]).read().rstrip("\n")
+text = open(page).read()
+open_m, close_m = "<!-- written: bash tests-host/cost.sh -->", "<!-- end written -->"
+a, b = text.index(open_m) + len(open_m), text.index(close_m)
+open(page, "w").write(text[:a] + "\n" + out + "\n" + text[b:])
+PY
+echo "cost: wrote docs/cost.md" >&2

@@ -16,7 +16,7 @@
 //! in its cycle mode and the watchdog alarm is not rearmed; the TIMER's microsecond count
 //! times the sleep. The core only waits in `wfi` with its clocks running: the RP2040's
 //! DORMANT state (0.18 mA typical, datasheet §5.7.2, Table 637) needs the clocks stopped and
-//! rebuilt around it, which this build does not do (README, energy budget).
+//! rebuilt around it, which this build does not do (docs/energy.md).
 
 #![no_std]
 #![no_main]

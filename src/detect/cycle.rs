@@ -89,7 +89,7 @@ pub const ATTITUDE_MAX_DEG: u32 = 45;
 /// Gravity against the foot's standing up at a stance, at most, degrees.
 pub const FLAT_MAX_DEG: u32 = 60;
 /// The sensor's height above the foot's rolling contact, µm. A clip on the side of the shoe
-/// sits ≈ 4–6 cm above it, one on the laces ≈ 8–10 cm; measured: see the README.
+/// sits ≈ 4–6 cm above it, one on the laces ≈ 8–10 cm; measured: docs/accuracy.md (`gaitclip zupt-sweep`).
 pub const SENSOR_HEIGHT_UM: u32 = 80_000;
 
 /// cos²(45°) and cos²(60°) in Q30.

@@ -14,7 +14,7 @@ use crate::sensor::units::{AccelScale, GyroScale};
 
 /// Longest hole of lost samples that is bridged: interpolated across when the next sample
 /// arrives, the stride it falls in flagged [`StrideFlags::BRIDGED`](crate::record::stride::StrideFlags::BRIDGED) and still measured.
-/// Chosen by measurement (`gaitclip holes`, the README's hole table): the longest hole
+/// Chosen by measurement (`gaitclip holes`, its table in docs/clocks-and-holes.md): the longest hole
 /// whose mean |length error| against the uncut recordings stays ≤ 1 cm at the recordings'
 /// rate and at half of it (with the cycle detector and the ZUPT stride as the default:
 /// 30 ms holes cost 10.6 mm at 100 Hz in clusters in the swing; 30 ms until then).
@@ -29,7 +29,7 @@ const _: () = assert!(BRIDGE_MAX_MS <= FILL_MAX_MS && FILL_MAX_MS <= MIN_MOVEMEN
 
 /// The model the firmware ships with as its stride length: the one with the best
 /// leave-one-dataset-out score, as `gaitclip train` measured it
-/// ([`crate::length::trained::LODO_BEST`]; the README's length tables).
+/// ([`crate::length::trained::LODO_BEST`]; the length tables of docs/accuracy.md).
 pub const DEFAULT_MODEL: Model = crate::length::trained::LODO_BEST;
 
 /// What the pipeline needs to know about the data.

@@ -44,7 +44,7 @@ RSC_MEASUREMENT, RSC_FEATURE, SENSOR_LOCATION, SC_CONTROL_POINT = 0x2A53, 0x2A54
 BATTERY_LEVEL = 0x2A19
 MANUFACTURER, MODEL, FIRMWARE = 0x2A29, 0x2A24, 0x2A26
 
-# What the pod's table lists (boards/common/src/rsc_gatt.rs, README): nothing more.
+# What the pod's table lists (boards/common/src/rsc_gatt.rs, docs/bluetooth.md): nothing more.
 TABLE = {
     GAP: {0x2A00, 0x2A01},
     GATT: set(),

@@ -321,7 +321,7 @@ pub fn savings(insn_per_sample: f64) -> Vec<Saving> {
     out
 }
 
-/// The budget tables in Markdown, for the README: the nRF52840 builds at `m4_insn` and the
+/// The budget tables in Markdown, for docs/energy.md: the nRF52840 builds at `m4_insn` and the
 /// Pico at `m0_insn` instructions per sample of walking (strides included).
 pub fn report(m4_insn: f64, m0_insn: f64) -> String {
     let boards = [

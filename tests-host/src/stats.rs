@@ -1,5 +1,5 @@
 //! The statistics every table of the host tools reports, defined once: a "median" or a
-//! "p95" column means the same thing in every table of the README.
+//! "p95" column means the same thing in every table of docs/.
 
 /// The `q`-quantile by nearest rank: the smallest value with at least `q` of the values at
 /// or below it (`q` in (0, 1]; the p95 of 20 values is the 19th). NaN when empty.

@@ -89,7 +89,7 @@ fn gaitmap_walk_strides_and_lengths() {
 }
 
 /// The gait core scored against the events and strides of the recordings, as
-/// `gaitclip eval` reports them; the bounds sit just under what the README's table shows so
+/// `gaitclip eval` reports them; the bounds sit just under what docs/accuracy.md's table shows so
 /// that a regression fails here.
 #[test]
 fn eval_figures_on_recordings() {

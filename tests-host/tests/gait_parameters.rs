@@ -1,6 +1,6 @@
 //! The per-stride gait parameters against the references of `../shared/datasets` (skipped
 //! with a message when absent; a failure in CI). The bounds sit a margin above what
-//! `gaitclip gait` measured (README, "Gait parameters"), so that a regression in the events,
+//! `gaitclip gait` measured (docs/accuracy.md, "Gait parameters"), so that a regression in the events,
 //! the ZUPT trajectory or the parameter stage fails here.
 
 use gaitclip_host::datasets::{self, root_or_skip};

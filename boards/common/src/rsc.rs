@@ -22,7 +22,7 @@
 //! (RSCS v1.0, 2012-08-07, §2 and the RSC Measurement characteristic). Both are per stride of
 //! the instrumented foot: the cadence sent is strides per minute, half the steps per minute
 //! of both feet ([`gaitclip::record::gait::GaitParameters::cadence_spm`]) that the logs and the
-//! JSON give. Consumers differ in what they make of it: the README's interoperability table.
+//! JSON give. Consumers differ in what they make of it: the interoperability table of docs/bluetooth.md.
 
 use gaitclip::record::gait::Gait;
 use gaitclip::record::stride::Stride;

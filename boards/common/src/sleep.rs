@@ -50,7 +50,7 @@ pub const THRESHOLD_UNIT: MotionThresholdUnit = MotionThresholdUnit::Mg32;
 
 /// Motion that wakes the clip: 96 mg of high-passed acceleration on any axis, three counts
 /// of the 32 mg unit. Checked on the real stands of `../shared/datasets` (`gaitclip wake`,
-/// README): at 96 mg the clip wakes a median 0.1 s into the walk (90 % within 0.25 s), early
+/// docs/energy.md): at 96 mg the clip wakes a median 0.1 s into the walk (90 % within 0.25 s), early
 /// (sway) from 4 of the 200 stands the labelled walks hold, and sleeps through the first
 /// second of none; 32 mg wakes early from a fifth of them, 160 mg sleeps through some.
 pub const WAKE_THRESHOLD_MG: u32 = 96;

@@ -153,7 +153,7 @@ enum Cmd {
         #[arg(long, default_value = "target/cost")]
         scratch: PathBuf,
     },
-    /// Print the energy budget of the real boards (the README's energy tables; `cost`
+    /// Print the energy budget of the real boards (docs/energy.md's tables; `cost`
     /// prints the same from the instructions it measures) for given instruction counts per
     /// sample of walking, strides included.
     Energy {
@@ -165,7 +165,7 @@ enum Cmd {
         m0: f64,
     },
     /// Put the sensor to sleep at every stand of the datasets and say when the wake rule
-    /// would wake it: early in the stand, how far into the walk, or not at all (the README's
+    /// would wake it: early in the stand, how far into the walk, or not at all (docs/energy.md's
     /// wake table).
     Wake {
         /// The folder holding the datasets (`../shared/datasets`).
@@ -173,7 +173,7 @@ enum Cmd {
         datasets: PathBuf,
     },
     /// Cut holes of 1–16 samples into the walking strides of the datasets with per-stride
-    /// references and print what bridging them costs, by hole length (the README's hole
+    /// references and print what bridging them costs, by hole length (docs/clocks-and-holes.md's hole
     /// table, and the bridge limit it gives).
     Holes {
         /// The folder holding the datasets (`../shared/datasets`).
@@ -182,7 +182,7 @@ enum Cmd {
     },
     /// Sweep the ZUPT stride's physical settings on the datasets with per-stride lengths:
     /// the sensor's height above the rolling contact, and the gyro's full-scale range
-    /// (clipping), by stride speed (the README's tables).
+    /// (clipping), by stride speed (docs/accuracy.md's tables).
     ZuptSweep {
         /// The folder holding the datasets (`../shared/datasets`).
         #[arg(default_value = "../../shared/datasets")]
