@@ -5,6 +5,7 @@
 //! Indices are sample numbers since the pipeline started (holes counted), lengths mm.
 
 use crate::record::gait::GaitParameters;
+use crate::sensor::rate::SampleRate;
 
 /// The longest stride a person makes, mm: an elite sprinter's stride (two steps) is about
 /// 5 m. A model that says more was fed something else, and the stride is flagged
@@ -121,7 +122,39 @@ pub struct Stride {
     pub flags: StrideFlags,
 }
 
+/// A stride's times in milliseconds, as every log of it states them (the defmt line, the
+/// serial line): one definition of what `t`, `dur` and the four phases are.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct StrideTimesMs {
+    /// The start (the stance instant) since the first sample.
+    pub start: u32,
+    /// Start to end.
+    pub duration: u32,
+    /// Start to heel-off: the part of this stride's stance before the foot rolls.
+    pub stance: u32,
+    /// Heel-off to toe-off.
+    pub push_off: u32,
+    /// Toe-off to heel-strike.
+    pub swing: u32,
+    /// Heel-strike to the end (the next stance instant).
+    pub heel_strike: u32,
+}
+
 impl Stride {
+    /// The stride's times at `rate`. The four phases add up to the duration (each interval
+    /// is rounded on its own, so they may differ from it by a millisecond or two).
+    pub fn times_ms(&self, rate: SampleRate) -> StrideTimesMs {
+        let ms = |a: u32, b: u32| rate.ms_of_samples(b.wrapping_sub(a));
+        StrideTimesMs {
+            start: rate.ms_of_samples(self.start),
+            duration: ms(self.start, self.end),
+            stance: ms(self.start, self.heel_off),
+            push_off: ms(self.heel_off, self.toe_off),
+            swing: ms(self.toe_off, self.heel_strike),
+            heel_strike: ms(self.heel_strike, self.end),
+        }
+    }
+
     /// Sets the length, clamped to [`MAX_STRIDE_MM`] and flagged
     /// [`StrideFlags::IMPLAUSIBLE`] above it.
     pub fn set_length_mm(&mut self, mm: u32) {
@@ -140,4 +173,40 @@ pub struct StepAmplitude {
     pub peak_to_valley: i32,
     /// Samples since the previous step's peak (0 for a walk's first step).
     pub period: u32,
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn times_are_the_intervals_between_the_events() {
+        let s = Stride {
+            start: 200,
+            heel_off: 210,
+            toe_off: 240,
+            heel_strike: 301,
+            end: 400,
+            ..Stride::default()
+        };
+        let t = s.times_ms(SampleRate::from_hz(200).unwrap());
+        assert_eq!(
+            t,
+            StrideTimesMs {
+                start: 1000,
+                duration: 1000,
+                stance: 50,
+                push_off: 150,
+                swing: 305,
+                heel_strike: 495,
+            }
+        );
+        // A 204.8 Hz recording: 1024 samples are exactly 5 s.
+        let t = Stride {
+            end: 1024,
+            ..Stride::default()
+        }
+        .times_ms(SampleRate::from_millihertz(204_800).unwrap());
+        assert_eq!(t.duration, 5000);
+    }
 }

@@ -66,18 +66,18 @@ pub fn banner(
 
 /// One stride.
 pub fn stride(out: &mut impl Write, rate: SampleRate, s: &Stride) -> fmt::Result {
-    let ms = |a: u32, b: u32| rate.ms_of_samples(b.wrapping_sub(a));
+    let t = s.times_ms(rate);
     write!(
         out,
         "{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{}\r\n",
         s.index,
-        rate.ms_of_samples(s.start),
+        t.start,
         s.length_mm,
-        ms(s.start, s.end),
-        ms(s.start, s.heel_off),
-        ms(s.heel_off, s.toe_off),
-        ms(s.toe_off, s.heel_strike),
-        ms(s.heel_strike, s.end),
+        t.duration,
+        t.stance,
+        t.push_off,
+        t.swing,
+        t.heel_strike,
         s.climb_mm,
         s.flags.0,
         s.flags.valid() as u8,

@@ -64,7 +64,7 @@ impl StrideLog {
 
     /// Logs one stride.
     pub fn stride(&mut self, s: &Stride, serial: &mut impl Write) {
-        let ms = |a: u32, b: u32| self.rate.ms_of_samples(b.wrapping_sub(a));
+        let t = s.times_ms(self.rate);
         self.strides += 1;
         if s.flags.counts_distance() {
             self.distance_mm += s.length_mm as u64;
@@ -77,14 +77,14 @@ impl StrideLog {
         defmt::println!(
             "stride {=u32} t={=u32} dur={=u32} len={=u32} climb={=i32} phases={=u32}/{=u32}/{=u32}/{=u32} ms flags={=u16} idx={=u32},{=u32},{=u32},{=u32},{=u32} gait={=u16},{=u16},{=u16},{=u16},{=u16},{=u16},{=i16} {=str}",
             s.index,
-            self.rate.ms_of_samples(s.start),
-            ms(s.start, s.end),
+            t.start,
+            t.duration,
             s.length_mm,
             s.climb_mm,
-            ms(s.start, s.heel_off),
-            ms(s.heel_off, s.toe_off),
-            ms(s.toe_off, s.heel_strike),
-            ms(s.heel_strike, s.end),
+            t.stance,
+            t.push_off,
+            t.swing,
+            t.heel_strike,
             s.flags.0,
             s.start,
             s.heel_off,
