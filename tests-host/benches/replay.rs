@@ -3,9 +3,9 @@
 //! gaitmap's pipeline on the same trace. Needs ../shared/datasets.
 
 use criterion::{criterion_group, criterion_main, Criterion, Throughput};
-use gaitclip_host::cost::TRACE;
-use gaitclip_host::trace::Ranges;
-use gaitclip_host::{csv_trace, datasets, replay};
+use gaitclip_host::cost::report::TRACE;
+use gaitclip_host::io::trace::Ranges;
+use gaitclip_host::{io::csv_trace, io::datasets, replay};
 
 fn replay_trace(c: &mut Criterion) {
     let Some(root) = datasets::root_or_skip("bench replay") else {

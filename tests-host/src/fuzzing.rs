@@ -12,9 +12,9 @@ use gaitclip::record::stride::{StrideFlags, MAX_STRIDE_MM};
 use gaitclip::sensor::rate::SampleRate;
 use gaitclip::sensor::sample::{AccelRange, GyroRange, RawSample};
 
+use crate::io::trace::{Ranges, Trace};
 use crate::replay::{replay, StrideReport};
-use crate::trace::{Ranges, Trace};
-use crate::{csv_trace, mcap_io};
+use crate::{io::csv_trace, io::mcap_io};
 
 /// A fuzz target's body: panics when an invariant breaks.
 pub type Target = fn(&[u8]);

@@ -32,8 +32,8 @@ use gaitclip_board::rsc_gatt::{self, PodEvent, PodLink, PodObserver};
 use serde_json::json;
 use trouble_host::prelude::{Address, ExternalController};
 
+use crate::io::trace::{Ranges, Trace};
 use crate::replay::{self, Prepared};
-use crate::trace::{Ranges, Trace};
 
 /// Where the HCI controller is.
 #[derive(Clone, Debug, PartialEq, Eq)]

@@ -14,9 +14,9 @@ use gaitclip::sensor::rate::SampleRate;
 use gaitclip::sensor::sample::RawSample;
 use serde::Serialize;
 
-use crate::clock::{Gap, SampleClock, TimeGoesBack};
-use crate::rails::{self, AxisReport, RailsReport};
-use crate::trace::{Ranges, Trace};
+use crate::io::clock::{Gap, SampleClock, TimeGoesBack};
+use crate::io::rails::{self, AxisReport, RailsReport};
+use crate::io::trace::{Ranges, Trace};
 
 /// Why a trace cannot be replayed.
 #[derive(Debug, thiserror::Error)]
@@ -360,7 +360,7 @@ pub struct Prepared {
     pub clock: SampleClock,
     /// The rate the core runs at.
     pub rate: SampleRate,
-    /// Where each axis clipped ([`crate::rails`]), and how often.
+    /// Where each axis clipped ([`crate::io::rails`]), and how often.
     pub rails: RailsReport,
     /// Rows read and re-sent samples dropped.
     read: (usize, usize),
@@ -440,7 +440,7 @@ impl Prepared {
 }
 
 /// A trace ready for the core ([`Prepared`]): converted to counts at `ranges`, its sample
-/// clock recovered from its stamps ([`crate::clock`]).
+/// clock recovered from its stamps ([`crate::io::clock`]).
 pub fn prepare(trace: &Trace, ranges: Ranges) -> Result<Prepared, ReplayError> {
     let (samples, repeated) = Trace::drop_repeats(trace.samples.clone(), Some(trace.rate_hz))?;
     let stamps: Vec<f64> = samples.iter().map(|s| s.t_s).collect();

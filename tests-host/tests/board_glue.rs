@@ -231,7 +231,7 @@ fn serial_stride_line_parses_back() {
 
 #[test]
 fn startup_nags_until_still_then_reports_bias_and_heading() {
-    let counts = gaitclip_host::fixtures::firmware_trace_counts().unwrap();
+    let counts = gaitclip_host::sim::fixtures::firmware_trace_counts().unwrap();
     let rate = SampleRate::from_hz(200).unwrap();
     let cfg = gaitclip::pipeline::config::Config::new(
         rate,

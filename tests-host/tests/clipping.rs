@@ -1,14 +1,14 @@
 //! The clipped accelerometer put back ([`gaitclip::detect::clipping`]), measured on real recordings
 //! clipped on purpose (`gaitclip clipping`), and the rails learnt from the data
-//! ([`gaitclip_host::rails`]). Bounds just above the figures measured on 2026-12-03.
+//! ([`gaitclip_host::io::rails`]). Bounds just above the figures measured on 2026-12-03.
 
 use gaitclip::sensor::sample::{AccelRange, AxisRails, Rails};
-use gaitclip_host::clip_sweep::{sweep, CLIPPINGS};
-use gaitclip_host::datasets::{self, root_or_skip};
-use gaitclip_host::markdown::ErrorStats;
-use gaitclip_host::rails::{learn, RailSource};
-use gaitclip_host::trace::GivenRanges;
-use gaitclip_host::trace::{ImuSample, Ranges, G_MPS2};
+use gaitclip_host::eval::clip_sweep::{sweep, CLIPPINGS};
+use gaitclip_host::eval::markdown::ErrorStats;
+use gaitclip_host::io::datasets::{self, root_or_skip};
+use gaitclip_host::io::rails::{learn, RailSource};
+use gaitclip_host::io::trace::GivenRanges;
+use gaitclip_host::io::trace::{ImuSample, Ranges, G_MPS2};
 
 #[test]
 fn clipped_strides_are_put_back_within_2_cm_at_8_g_and_nearer_at_4_g() {
@@ -56,8 +56,9 @@ fn a_rail_below_the_nominal_range_is_learnt_from_the_recording() {
         return;
     };
     // esangeni_run's z axis clips at −15.65 g, under the ±16 g its counts reach.
-    let t = gaitclip_host::csv_trace::read(&root.join("esangeni_run/course_run_800hz.csv"), None)
-        .unwrap();
+    let t =
+        gaitclip_host::io::csv_trace::read(&root.join("esangeni_run/course_run_800hz.csv"), None)
+            .unwrap();
     let r = learn(&t.samples, Ranges::default(), GivenRanges::default());
     let z = &r.axes[2];
     eprintln!("{}", r.clipped_line());

@@ -5,11 +5,11 @@
 //! find the holes where they were cut and give the same strides as the same samples with
 //! their true stamps. Skipped with a message without `../shared/datasets` (a failure in CI).
 
-use gaitclip_host::clock::SampleClock;
-use gaitclip_host::csv_trace;
-use gaitclip_host::datasets::root_or_skip;
+use gaitclip_host::io::clock::SampleClock;
+use gaitclip_host::io::csv_trace;
+use gaitclip_host::io::datasets::root_or_skip;
+use gaitclip_host::io::trace::{ImuSample, Ranges, Trace};
 use gaitclip_host::replay::{replay_summarised, StrideReport, Summary};
-use gaitclip_host::trace::{ImuSample, Ranges, Trace};
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 

@@ -5,10 +5,10 @@
 
 use gaitclip::pipeline::config::Config;
 use gaitclip::pipeline::detectors::Detector;
-use gaitclip_host::cost::size_of_elf;
-use gaitclip_host::firmware::{self, repo_root};
-use gaitclip_host::insn_count;
-use gaitclip_host::qemu;
+use gaitclip_host::cost::firmware::{self, repo_root};
+use gaitclip_host::cost::insn_count;
+use gaitclip_host::cost::qemu;
+use gaitclip_host::cost::report::size_of_elf;
 use gaitclip_host::replay::core_strides;
 
 fn plugin() -> std::path::PathBuf {
@@ -49,7 +49,7 @@ fn bench_counts_are_complete_and_repeatable_on_m4() {
     let a = insn_count::run_bench(&elf, qemu::MACHINE_M4, &plugin, &scratch).expect("counted run");
     let b = insn_count::run_bench(&elf, qemu::MACHINE_M4, &plugin, &scratch).expect("counted run");
 
-    let counts = gaitclip_host::fixtures::firmware_trace_counts().expect("demo trace");
+    let counts = gaitclip_host::sim::fixtures::firmware_trace_counts().expect("demo trace");
     let host = core_strides(&counts, demo_config());
     assert_eq!(a.samples as usize, counts.len());
     assert_eq!(a.strides as usize, host.len());
@@ -90,7 +90,7 @@ fn peak_valley_bench_counts_are_complete_and_repeatable_on_m4() {
     let b = insn_count::run_bench_peak_valley(&elf, qemu::MACHINE_M4, &plugin, &scratch)
         .expect("counted run");
 
-    let counts = gaitclip_host::fixtures::firmware_trace_counts().expect("demo trace");
+    let counts = gaitclip_host::sim::fixtures::firmware_trace_counts().expect("demo trace");
     let mut config = demo_config();
     config.detector = Detector::PeakValley;
     let host = core_strides(&counts, config);
@@ -120,7 +120,7 @@ fn bench_runs_to_the_end_on_m0_with_each_detector() {
     }
     let plugin = plugin();
     let scratch = tempdir("m0");
-    let counts = gaitclip_host::fixtures::firmware_trace_counts().expect("demo trace");
+    let counts = gaitclip_host::sim::fixtures::firmware_trace_counts().expect("demo trace");
     for detector in [Detector::Cycle, Detector::PeakValley] {
         let elf = firmware::build_for("boards/bench", "bench", "thumbv6m-none-eabi", detector, &[])
             .expect("the benchmark firmware builds for the M0");

@@ -2,7 +2,7 @@
 
 use std::path::Path;
 
-use gaitclip_host::csv_trace::{parse, CsvError};
+use gaitclip_host::io::csv_trace::{parse, CsvError};
 
 const HEADER: &str = "t_s,acc_x,acc_y,acc_z,gyr_x,gyr_y,gyr_z\n";
 

@@ -1,14 +1,14 @@
 //! The cycle detector's fixed-point strides against their `f64` twin
-//! ([`gaitclip_host::cycle_ref`]): every stride of every trial of the three datasets, at the
+//! ([`gaitclip_host::reference::cycle_ref`]): every stride of every trial of the three datasets, at the
 //! MPU6050's widest ranges, at ±250 °/s (where nearly every stride clips and the tilt
 //! is put back on the clipped samples) and at ±8 g and ±4 g (where the accelerometer's heel
 //! strikes and push-offs clip and their loss is put back), within 1 mm of the twin.
 
 use gaitclip::sensor::sample::{AccelRange, GyroRange};
-use gaitclip_host::cycle_ref::{self, Skipped};
-use gaitclip_host::datasets::root_or_skip;
-use gaitclip_host::trace::Ranges;
-use gaitclip_host::{csv_trace, datasets, replay};
+use gaitclip_host::io::datasets::root_or_skip;
+use gaitclip_host::io::trace::Ranges;
+use gaitclip_host::reference::cycle_ref::{self, Skipped};
+use gaitclip_host::{io::csv_trace, io::datasets, replay};
 
 #[test]
 fn cycle_strides_match_the_f64_twin_within_1_mm() {

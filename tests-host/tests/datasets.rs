@@ -2,10 +2,10 @@
 //! in CI). Issue-2 level checks: the chain finds the strides of a real walk and measures them
 //! to within a few percent.
 
-use gaitclip_host::csv_trace;
-use gaitclip_host::datasets::root_or_skip;
+use gaitclip_host::io::csv_trace;
+use gaitclip_host::io::datasets::root_or_skip;
+use gaitclip_host::io::trace::Ranges;
 use gaitclip_host::replay::replay;
-use gaitclip_host::trace::Ranges;
 
 #[derive(Debug)]
 struct RefStride {
@@ -93,12 +93,12 @@ fn gaitmap_walk_strides_and_lengths() {
 /// that a regression fails here.
 #[test]
 fn eval_figures_on_recordings() {
-    use gaitclip_host::stats::abs_quantile;
-    use gaitclip_host::{datasets, eval};
-    let Some(root) = gaitclip_host::datasets::root_or_skip("eval_figures_on_recordings") else {
+    use gaitclip_host::eval::stats::abs_quantile;
+    use gaitclip_host::{eval::scoring, io::datasets};
+    let Some(root) = gaitclip_host::io::datasets::root_or_skip("eval_figures_on_recordings") else {
         return;
     };
-    let detector = eval::core_detector(|_| {});
+    let detector = scoring::core_detector(|_| {});
     // (dataset, min F1, max median |toe-off|, |heel-strike| ms, min swing IoU)
     for (name, f1, to, hs, iou) in [
         ("gaitmap_walk", 0.99, 30.0, 70.0, 0.80),
@@ -106,7 +106,7 @@ fn eval_figures_on_recordings() {
         ("ipol_gait_events", 0.98, 45.0, 35.0, 0.82),
     ] {
         let d = datasets::load(&root.join(name)).unwrap();
-        let r = eval::evaluate(&d, &detector, 0, 1).unwrap();
+        let r = scoring::evaluate(&d, &detector, 0, 1).unwrap();
         let t = &r.tally;
         let (m_to, m_hs) = (
             abs_quantile(&t.toe_off_ms, 0.5),

@@ -1,8 +1,8 @@
 //! Every measured table of `docs/` is what its command prints now (`gaitclip docs`): a
 //! change that moves a figure fails here until the docs are regenerated.
 
-use gaitclip_host::datasets::root_or_skip;
-use gaitclip_host::docs;
+use gaitclip_host::eval::docs;
+use gaitclip_host::io::datasets::root_or_skip;
 
 #[test]
 fn generated_docs_are_current() {

@@ -3,9 +3,9 @@
 
 use gaitclip::length::estimate::LengthEstimator;
 use gaitclip::record::stride::{Stride, StrideFlags};
-use gaitclip_host::datasets::root_or_skip;
-use gaitclip_host::trace::Ranges;
-use gaitclip_host::{csv_trace, datasets, replay};
+use gaitclip_host::io::datasets::root_or_skip;
+use gaitclip_host::io::trace::Ranges;
+use gaitclip_host::{io::csv_trace, io::datasets, replay};
 
 fn stride(start: u32, end: u32, length_mm: u32, flags: u16) -> Stride {
     Stride {

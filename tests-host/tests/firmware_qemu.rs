@@ -10,11 +10,11 @@ use gaitclip::sensor::rate::SampleRate;
 use gaitclip::sensor::sample::RawSample;
 use gaitclip_board::sleep::{SleepPolicy, SLEEP};
 use gaitclip_board::{replay_holes, replay_mpu6050, replay_still};
-use gaitclip_host::clock::Gap;
-use gaitclip_host::firmware::{self, parse_stride_line, LoggedStride};
-use gaitclip_host::qemu::{self, RunOptions};
+use gaitclip_host::cost::firmware::{self, parse_stride_line, LoggedStride};
+use gaitclip_host::cost::qemu::{self, RunOptions};
+use gaitclip_host::io::clock::Gap;
+use gaitclip_host::io::trace::Ranges;
 use gaitclip_host::replay::replay_counts_with;
-use gaitclip_host::trace::Ranges;
 
 /// The movement buffer of the micro:bit firmware (`boards/microbit/main.rs`).
 const MICROBIT_MOVEMENT_SAMPLES: usize = 256;
@@ -66,7 +66,7 @@ fn qemu_m0_bridges_holes_as_the_host_replay() {
     let (out, on_target) = run_to_exit(&elf, qemu::MACHINE_M0);
 
     // The host: the same counts without the lost samples, each run declared as a gap.
-    let all = gaitclip_host::fixtures::firmware_trace_counts().unwrap();
+    let all = gaitclip_host::sim::fixtures::firmware_trace_counts().unwrap();
     let (mut counts, mut gaps): (Vec<RawSample>, Vec<Gap>) = (Vec::new(), Vec::new());
     let mut lost = replay_holes::LOST.iter().peekable();
     let mut n = 0usize;
@@ -192,7 +192,7 @@ fn strides_equal_host_replay(
     let elf = firmware::build_for(dir, bin, target, detector, &[]).expect("firmware builds");
     let (out, on_target) = run_to_exit(&elf, machine);
 
-    let counts = gaitclip_host::fixtures::firmware_trace_counts().unwrap();
+    let counts = gaitclip_host::sim::fixtures::firmware_trace_counts().unwrap();
     let ranges = Ranges::default();
     let mut config = Config::new(
         SampleRate::from_hz(200).unwrap(),
@@ -332,7 +332,7 @@ fn sleeps_and_wakes_as_the_host_model<const M: usize>(
         .expect("firmware builds");
     let (out, on_target) = run_to_exit(&elf, machine);
 
-    let counts = gaitclip_host::fixtures::firmware_trace_counts().unwrap();
+    let counts = gaitclip_host::sim::fixtures::firmware_trace_counts().unwrap();
     let ranges = Ranges::default();
     let config = Config::new(
         SampleRate::from_hz(200).unwrap(),
@@ -381,7 +381,7 @@ fn qemu_m4_sleeps_when_still_and_wakes_as_the_host_model() {
     ) else {
         return;
     };
-    let counts = gaitclip_host::fixtures::firmware_trace_counts().unwrap();
+    let counts = gaitclip_host::sim::fixtures::firmware_trace_counts().unwrap();
     // The step the wake-up cut into is a gap stride, flagged, not dropped; every stride
     // after it has the length, events and gait of the replay that never slept (its sample
     // indices later by the periods the still runs added), but the first: after a gap it

@@ -8,7 +8,7 @@ use gaitclip::fixed::{isqrt_u64, mul_q30, QuatQ30, Q30_ONE};
 use gaitclip::sensor::rate::SampleRate;
 use gaitclip::sensor::sample::{AccelRange, GyroRange, RawSample};
 use gaitclip::signal::mean_filter::MeanFilter;
-use gaitclip_host::fixtures::FIRMWARE_TRACE;
+use gaitclip_host::sim::fixtures::FIRMWARE_TRACE;
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 
@@ -66,7 +66,7 @@ fn quat_f64(q: QuatQ30) -> [f64; 4] {
 }
 
 fn rotate_f64(q: [f64; 4], v: [f64; 3]) -> [f64; 3] {
-    let m = gaitclip_host::eval::rotation_matrix(q);
+    let m = gaitclip_host::eval::scoring::rotation_matrix(q);
     [0, 1, 2].map(|i| (0..3).map(|k| m[i][k] * v[k]).sum())
 }
 
@@ -430,7 +430,7 @@ fn quat_mul(a: [f64; 4], b: [f64; 4]) -> [f64; 4] {
 #[test]
 fn zupt_displacement_matches_f64_reference_within_1mm() {
     let dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../fixtures");
-    let counts = gaitclip_host::fixtures::firmware_trace_counts().unwrap();
+    let counts = gaitclip_host::sim::fixtures::firmware_trace_counts().unwrap();
     let truth = std::fs::read_to_string(dir.join(format!("{FIRMWARE_TRACE}.truth.csv"))).unwrap();
     let rate = SampleRate::from_hz(200).unwrap();
     let mut checked = 0;
@@ -665,7 +665,7 @@ fn cycle_energy_matches_f64_within_its_bound() {
             let bias = [0; 3].map(|_| r.random_range(-200..200));
             let g = lsb_g as i32 + r.random_range(-50..50);
             let e = cfg.energy_q16(&s, bias, g) as f64;
-            let exact = gaitclip_host::cycle_ref::energy(&config, &s, bias, g) * 65536.0;
+            let exact = gaitclip_host::reference::cycle_ref::energy(&config, &s, bias, g) * 65536.0;
             if exact >= (1u64 << 26) as f64 {
                 assert_eq!(e, (1u64 << 26) as f64, "saturates at 2²⁶");
                 continue;

@@ -4,11 +4,11 @@
 use std::path::PathBuf;
 
 use gaitclip::sensor::rate::SampleRate;
-use gaitclip_host::csv_trace;
-use gaitclip_host::fixtures::{self, FIRMWARE_TRACE};
+use gaitclip_host::io::csv_trace;
+use gaitclip_host::io::trace::Ranges;
 use gaitclip_host::replay::{replay, replay_counts};
-use gaitclip_host::sim;
-use gaitclip_host::trace::Ranges;
+use gaitclip_host::sim::fixtures::{self, FIRMWARE_TRACE};
+use gaitclip_host::sim::gait_sim;
 
 fn dir() -> PathBuf {
     PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../fixtures")
@@ -34,7 +34,7 @@ fn committed_fixtures_are_not_stale() {
 #[test]
 fn csv_and_register_dump_hold_the_same_counts() {
     let trace = csv_trace::read(&dir().join(format!("{FIRMWARE_TRACE}.csv")), None).unwrap();
-    let counts = gaitclip_host::fixtures::firmware_trace_counts().unwrap();
+    let counts = gaitclip_host::sim::fixtures::firmware_trace_counts().unwrap();
     assert_eq!(trace.samples.len(), counts.len());
     let r = Ranges::default();
     for (s, c) in trace.samples.iter().zip(&counts) {
@@ -60,9 +60,9 @@ fn csv_and_register_dump_hold_the_same_counts() {
 /// (the first step's slow heel rise is in stance for the first 55 ms: 0.749 m of 0.8 m).
 #[test]
 fn replay_finds_simulated_strides() {
-    for sc in sim::scenarios() {
+    for sc in gait_sim::scenarios() {
         let trace = csv_trace::read(&dir().join(format!("{}.csv", sc.name)), None).unwrap();
-        let truth = sim::simulate(&sc, Ranges::default()).truth;
+        let truth = gait_sim::simulate(&sc, Ranges::default()).truth;
         let got = replay(&trace, Ranges::default()).unwrap();
         assert_eq!(got.len(), truth.len(), "{}: stride count", sc.name);
         let t = |i: u32| i as f64 / sc.rate_hz;

@@ -3,9 +3,9 @@
 //! `gaitclip gait` measured (docs/accuracy.md, "Gait parameters"), so that a regression in the events,
 //! the ZUPT trajectory or the parameter stage fails here.
 
-use gaitclip_host::datasets::{self, root_or_skip};
-use gaitclip_host::gait_eval::{evaluate, table, GaitResult};
-use gaitclip_host::stats::{abs_quantile, median};
+use gaitclip_host::eval::gait_eval::{evaluate, table, GaitResult};
+use gaitclip_host::eval::stats::{abs_quantile, median};
+use gaitclip_host::io::datasets::{self, root_or_skip};
 
 fn errors(r: &GaitResult, parameter: &str, pace: Option<&str>) -> Vec<f64> {
     r.comparisons

@@ -6,8 +6,8 @@
 //! (a failure in CI).
 
 use gaitclip::pipeline::config::BRIDGE_MAX_MS;
-use gaitclip_host::datasets::root_or_skip;
-use gaitclip_host::hole_sweep::{cost, patterns, walks, Cost, MEAN_LENGTH_BOUND_M};
+use gaitclip_host::eval::hole_sweep::{cost, patterns, walks, Cost, MEAN_LENGTH_BOUND_M};
+use gaitclip_host::io::datasets::root_or_skip;
 
 #[test]
 fn holes_of_the_bridge_limit_cost_under_a_centimetre() {

@@ -8,8 +8,8 @@ use gaitclip::length::fuzzy::{lu_k_q16, D_UNIVERSE_Q16, F_UNIVERSE_Q16};
 use gaitclip::length::models::{self, Model, Settings, MAX_TERMS};
 use gaitclip::record::stride::Stride;
 use gaitclip::sensor::rate::SampleRate;
-use gaitclip_host::fit::least_squares;
-use gaitclip_host::length_ref;
+use gaitclip_host::reference::length_ref;
+use gaitclip_host::train::fit::least_squares;
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 
@@ -317,9 +317,9 @@ fn zhang_fit_on_the_papers_table_1() {
 fn the_zupt_shortcut_gives_the_full_features_length() {
     use gaitclip::length::features::Features;
     use gaitclip::length::models::{predict_mm, Model, Settings};
-    let counts = gaitclip_host::fixtures::firmware_trace_counts().unwrap();
+    let counts = gaitclip_host::sim::fixtures::firmware_trace_counts().unwrap();
     let rate = gaitclip::sensor::rate::SampleRate::from_hz(200).unwrap();
-    let ranges = gaitclip_host::trace::Ranges::default();
+    let ranges = gaitclip_host::io::trace::Ranges::default();
     let config =
         gaitclip::pipeline::config::Config::new(rate, ranges.accel.scale(), ranges.gyro.scale());
     let (strides, _) = gaitclip_host::replay::core_run_with_stats(&counts, &[], config);

@@ -5,12 +5,12 @@ use std::collections::BTreeMap;
 use std::io::Cursor;
 use std::path::PathBuf;
 
-use gaitclip_host::csv_trace;
-use gaitclip_host::mcap_io::{self, encode_ros2_imu, McapError, ROS2_IMU_SCHEMA};
+use gaitclip_host::io::csv_trace;
+use gaitclip_host::io::mcap_io::{self, encode_ros2_imu, McapError, ROS2_IMU_SCHEMA};
+use gaitclip_host::io::trace::Ranges;
 use gaitclip_host::replay::replay;
-use gaitclip_host::trace::Ranges;
 
-fn demo() -> gaitclip_host::trace::Trace {
+fn demo() -> gaitclip_host::io::trace::Trace {
     let p = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../fixtures/demo_walk.csv");
     csv_trace::read(&p, None).unwrap()
 }

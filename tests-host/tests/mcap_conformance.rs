@@ -15,7 +15,7 @@ use std::path::{Path, PathBuf};
 use std::sync::mpsc;
 use std::time::Duration;
 
-use gaitclip_host::mcap_io::{read_records, McapError, McapRecord};
+use gaitclip_host::io::mcap_io::{read_records, McapError, McapRecord};
 use serde_json::Value;
 
 /// A file that takes longer than this to read counts as a hang.
@@ -205,7 +205,7 @@ fn classify(path: &Path, e: McapError) -> String {
 #[test]
 fn conformance_files_are_read_exactly_or_rejected_clearly() {
     let Some(root) =
-        gaitclip_host::datasets::shared_or_skip("mcap-conformance", "mcap_conformance")
+        gaitclip_host::io::datasets::shared_or_skip("mcap-conformance", "mcap_conformance")
     else {
         return;
     };

@@ -8,8 +8,8 @@
 use gaitclip::detect::peak_valley::{max_latency_ms, PeakValleyDetector, Step};
 use gaitclip::sensor::rate::SampleRate;
 use gaitclip::signal::low_pass::{alpha_q16, LowPass, LOW_PASS_LSB_PER_G};
-use gaitclip_host::peak_valley_ref;
-use gaitclip_host::{csv_trace, datasets};
+use gaitclip_host::reference::peak_valley_ref;
+use gaitclip_host::{io::csv_trace, io::datasets};
 use proptest::prelude::*;
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;

@@ -42,7 +42,7 @@ fn runs() -> impl Strategy<Value = Vec<RawSample>> {
 
 /// The demo walk's counts (200 Hz, ±16 g, ±2000 °/s): real strides to cut gaps into.
 fn walk() -> Vec<RawSample> {
-    gaitclip_host::fixtures::firmware_trace_counts().unwrap()
+    gaitclip_host::sim::fixtures::firmware_trace_counts().unwrap()
 }
 
 /// Feeds `samples` with a gap of `missing` before each index in `gaps`; checks every stride

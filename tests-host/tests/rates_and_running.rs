@@ -1,9 +1,9 @@
 //! Any sample rate (`gaitclip rates`) and the stance instant by pace (`gaitclip running`),
 //! with bounds just above the figures measured on 2026-12-03.
 
-use gaitclip_host::datasets::root_or_skip;
-use gaitclip_host::markdown::ErrorStats;
-use gaitclip_host::{csv_trace, rate_sweep, running};
+use gaitclip_host::eval::markdown::ErrorStats;
+use gaitclip_host::io::datasets::root_or_skip;
+use gaitclip_host::{eval::rate_sweep, eval::running, io::csv_trace};
 
 /// `esangeni_run` at 800 Hz and decimated to 400, 200 and 100 Hz: every stride found at every
 /// rate, no `too_long` stride at 800 Hz (1.9 s strides fit the buffer by time), and at
@@ -15,7 +15,8 @@ fn an_800_hz_run_and_its_decimations_give_the_same_strides() {
         return;
     };
     let t = csv_trace::read(&root.join("esangeni_run/course_run_800hz.csv"), None).unwrap();
-    let full = gaitclip_host::replay::replay(&t, gaitclip_host::trace::Ranges::default()).unwrap();
+    let full =
+        gaitclip_host::replay::replay(&t, gaitclip_host::io::trace::Ranges::default()).unwrap();
     assert!(
         full.iter().all(|s| !s.flags.contains(&"too_long")),
         "{full:#?}"

@@ -6,10 +6,10 @@ use std::path::Path;
 use gaitclip::detect::phases::PhaseMethod;
 use gaitclip::pipeline::config::Config;
 use gaitclip::pipeline::detectors::Detector;
-use gaitclip_host::datasets;
-use gaitclip_host::matching::Detected;
-use gaitclip_host::trace::{Ranges, Trace};
-use gaitclip_host::{csv_trace, reference, replay};
+use gaitclip_host::eval::matching::Detected;
+use gaitclip_host::io::datasets;
+use gaitclip_host::io::trace::{Ranges, Trace};
+use gaitclip_host::{io::csv_trace, reference::stance_chain, replay};
 
 /// Runs core and reference and returns the paired strides' largest event difference in
 /// samples, after asserting that both found the same strides (pairs one to one by overlap).
@@ -24,7 +24,7 @@ fn compare(name: &str, trace: &Trace, method: PhaseMethod) -> Vec<u32> {
         .iter()
         .map(Detected::from)
         .collect();
-    let refr = reference::strides(&counts, config);
+    let refr = stance_chain::strides(&counts, config);
     assert_eq!(
         core.len(),
         refr.len(),
@@ -74,7 +74,7 @@ fn check(name: &str, trace: &Trace, share: f64, max: u32) {
 #[test]
 fn fixtures_agree_with_reference() {
     let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("../fixtures");
-    for sc in gaitclip_host::sim::scenarios() {
+    for sc in gaitclip_host::sim::gait_sim::scenarios() {
         let t = csv_trace::read(&dir.join(format!("{}.csv", sc.name)), None).unwrap();
         // At 500 Hz the simulated push-off peak is broad and flat to within sensor noise:
         // which sample is its top depends on sub-count rounding (measured: 17 of 24 events

@@ -181,12 +181,12 @@ fn a_tilt_wakes_the_sensor_and_full_sampling_resumes_after_the_gyro_settles() {
 /// most 1 % of the walks (measured 2026-12-02: 4 early of 200, none slept through).
 #[test]
 fn the_wake_rule_catches_real_walks_and_keeps_still_through_real_stands() {
-    let Some(root) = gaitclip_host::datasets::root_or_skip(
+    let Some(root) = gaitclip_host::io::datasets::root_or_skip(
         "the_wake_rule_catches_real_walks_and_keeps_still_through_real_stands",
     ) else {
         return;
     };
-    let (results, table) = gaitclip_host::wake_eval::report(&root).unwrap();
+    let (results, table) = gaitclip_host::eval::wake_eval::report(&root).unwrap();
     println!("{table}");
     let stands: usize = results.iter().map(|r| r.stands).sum();
     assert!(stands >= 150, "{stands} stands");

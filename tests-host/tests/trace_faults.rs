@@ -7,10 +7,10 @@
 use std::path::PathBuf;
 
 use gaitclip::pipeline::config::{BRIDGE_MAX_MS, FILL_MAX_MS};
-use gaitclip_host::clock::{drop_repeats, Gap, SampleClock, TimeGoesBack};
-use gaitclip_host::csv_trace;
+use gaitclip_host::io::clock::{drop_repeats, Gap, SampleClock, TimeGoesBack};
+use gaitclip_host::io::csv_trace;
+use gaitclip_host::io::trace::{Ranges, Trace, G_MPS2};
 use gaitclip_host::replay::{replay, replay_summarised, StrideReport};
-use gaitclip_host::trace::{Ranges, Trace, G_MPS2};
 
 fn demo() -> Trace {
     let p = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../fixtures/demo_walk.csv");
@@ -361,7 +361,7 @@ fn samples_at_the_rails_flag_the_stride() {
 /// the clock recovered from them.
 #[test]
 fn jittered_pyshoe_traces_replay_as_if_on_the_grid() {
-    let Some(root) = gaitclip_host::datasets::root_or_skip("jittered_pyshoe_traces") else {
+    let Some(root) = gaitclip_host::io::datasets::root_or_skip("jittered_pyshoe_traces") else {
         return;
     };
     let mut jittered = 0;

@@ -11,8 +11,8 @@
 use gaitclip::length::features::Features;
 use gaitclip::length::models::{self, Model};
 use gaitclip::pipeline::config::DEFAULT_MODEL;
-use gaitclip_host::datasets::root_or_skip;
-use gaitclip_host::{codegen, datasets, train, training_set};
+use gaitclip_host::io::datasets::root_or_skip;
+use gaitclip_host::{io::datasets, train::codegen, train::training, train::training_set};
 
 #[test]
 fn shipped_models_are_current_exact_and_meet_targets() {
@@ -25,7 +25,7 @@ fn shipped_models_are_current_exact_and_meet_targets() {
     }
 
     // 1. Not stale.
-    let t = train::train(&runs).unwrap();
+    let t = training::train(&runs).unwrap();
     let source = codegen::rust_source(&t);
     let committed = std::fs::read_to_string(concat!(
         env!("CARGO_MANIFEST_DIR"),

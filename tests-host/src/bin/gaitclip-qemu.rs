@@ -5,7 +5,7 @@ use std::path::PathBuf;
 use std::process::ExitCode;
 
 use clap::Parser;
-use gaitclip_host::qemu::{self, RunOptions};
+use gaitclip_host::cost::qemu::{self, RunOptions};
 
 #[derive(Parser)]
 #[command(version, about)]

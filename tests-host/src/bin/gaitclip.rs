@@ -8,11 +8,11 @@ use gaitclip::detect::phases::PhaseMethod;
 use gaitclip::length::models::Model;
 use gaitclip::pipeline::config::Config;
 use gaitclip::pipeline::detectors::Detector;
-use gaitclip_host::eval;
-use gaitclip_host::trace::{Ranges, Trace};
+use gaitclip_host::eval::scoring;
+use gaitclip_host::io::trace::{Ranges, Trace};
 use gaitclip_host::{
-    codegen, csv_trace, datasets, fit, fixtures, length_eval, matching, mcap_io, replay, tables,
-    train, training_set,
+    eval::length_eval, eval::matching, eval::tables, io::csv_trace, io::datasets, io::mcap_io,
+    replay, sim::fixtures, train::codegen, train::fit, train::training, train::training_set,
 };
 
 #[derive(Parser)]
@@ -307,9 +307,9 @@ struct WriteError {
 
 /// The exit status for an error: by the first typed cause in its chain.
 fn status_of(e: &anyhow::Error) -> u8 {
-    use gaitclip_host::clock::TimeGoesBack;
-    use gaitclip_host::csv_trace::CsvError;
-    use gaitclip_host::mcap_io::McapError;
+    use gaitclip_host::io::clock::TimeGoesBack;
+    use gaitclip_host::io::csv_trace::CsvError;
+    use gaitclip_host::io::mcap_io::McapError;
     for cause in e.chain() {
         if let Some(c) = cause.downcast_ref::<CsvError>() {
             return match c {
@@ -501,9 +501,12 @@ fn run(cli: Cli) -> anyhow::Result<()> {
             let mut results = Vec::new();
             for dir in &datasets {
                 let d = datasets::load(dir)?;
-                results.push((d.name.clone(), gaitclip_host::gait_eval::evaluate(&d)?));
+                results.push((
+                    d.name.clone(),
+                    gaitclip_host::eval::gait_eval::evaluate(&d)?,
+                ));
             }
-            print!("{}", gaitclip_host::gait_eval::table(&results));
+            print!("{}", gaitclip_host::eval::gait_eval::table(&results));
         }
         Cmd::Eval {
             datasets,
@@ -514,7 +517,7 @@ fn run(cli: Cli) -> anyhow::Result<()> {
             stance,
         } => {
             let run_with = |which: Detector| {
-                eval::core_detector(move |c: &mut Config| {
+                scoring::core_detector(move |c: &mut Config| {
                     c.phases = phases.into();
                     c.detector = which;
                     if let Some(limits) = stance {
@@ -534,7 +537,7 @@ fn run(cli: Cli) -> anyhow::Result<()> {
                 let mut tallies = Vec::new();
                 for (k, (which, det)) in detectors.iter().enumerate() {
                     // The default detector gets the rotations and the event table.
-                    let r = eval::evaluate(&d, det, if k == 0 { rotate } else { 0 }, seed)?;
+                    let r = scoring::evaluate(&d, det, if k == 0 { rotate } else { 0 }, seed)?;
                     tallies.push((*which, r.tally.clone()));
                     if k == 0 {
                         results.push(r);
@@ -617,7 +620,7 @@ fn run(cli: Cli) -> anyhow::Result<()> {
         }
         Cmd::Train { datasets, out } => {
             let runs = training_set::load_training(&datasets)?;
-            let t = train::train(&runs)?;
+            let t = training::train(&runs)?;
             std::fs::write(&out, codegen::rust_source(&t))
                 .with_context(|| format!("writing {}", out.display()))?;
             eprintln!(
@@ -636,39 +639,45 @@ fn run(cli: Cli) -> anyhow::Result<()> {
             scratch,
         } => {
             let abs = |p: PathBuf| std::path::absolute(&p).unwrap_or(p);
-            let report = gaitclip_host::cost::report(&gaitclip_host::cost::Inputs {
-                plugin: abs(plugin),
-                datasets: abs(datasets),
-                criterion_estimates: abs(criterion),
-                gaitmap_json: abs(gaitmap),
-                scratch: abs(scratch),
-            })?;
+            let report =
+                gaitclip_host::cost::report::report(&gaitclip_host::cost::report::Inputs {
+                    plugin: abs(plugin),
+                    datasets: abs(datasets),
+                    criterion_estimates: abs(criterion),
+                    gaitmap_json: abs(gaitmap),
+                    scratch: abs(scratch),
+                })?;
             print!("{report}");
         }
-        Cmd::Energy { m4, m0 } => print!("{}", gaitclip_host::energy::report(m4, m0)),
-        Cmd::Wake { datasets } => print!("{}", gaitclip_host::wake_eval::report(&datasets)?.1),
+        Cmd::Energy { m4, m0 } => print!("{}", gaitclip_host::cost::energy::report(m4, m0)),
+        Cmd::Wake { datasets } => {
+            print!("{}", gaitclip_host::eval::wake_eval::report(&datasets)?.1)
+        }
         Cmd::Holes { datasets } => {
-            print!("{}", gaitclip_host::hole_sweep::report(&datasets)?);
+            print!("{}", gaitclip_host::eval::hole_sweep::report(&datasets)?);
         }
         Cmd::ZuptSweep { datasets } => {
-            print!("{}", gaitclip_host::zupt_sweep::report(&datasets)?);
+            print!("{}", gaitclip_host::eval::zupt_sweep::report(&datasets)?);
         }
         Cmd::Clipping { datasets } => {
-            print!("{}", gaitclip_host::clip_sweep::report(&datasets)?);
+            print!("{}", gaitclip_host::eval::clip_sweep::report(&datasets)?);
         }
         Cmd::Rates { datasets } => {
-            print!("{}", gaitclip_host::rate_sweep::report(&datasets)?);
+            print!("{}", gaitclip_host::eval::rate_sweep::report(&datasets)?);
         }
         Cmd::Running { datasets } => {
-            print!("{}", gaitclip_host::running::report(&datasets)?);
+            print!("{}", gaitclip_host::eval::running::report(&datasets)?);
         }
         Cmd::Flags { datasets } => {
-            print!("{}", gaitclip_host::flag_costs::report(&datasets)?);
+            print!("{}", gaitclip_host::eval::flag_costs::report(&datasets)?);
         }
         Cmd::Docs { datasets, check } => {
             let exe = std::env::current_exe().context("the path of this binary")?;
-            let pages =
-                gaitclip_host::docs::regenerate(&gaitclip_host::docs::docs_dir(), &datasets, &exe)?;
+            let pages = gaitclip_host::eval::docs::regenerate(
+                &gaitclip_host::eval::docs::docs_dir(),
+                &datasets,
+                &exe,
+            )?;
             let mut stale = Vec::new();
             for p in &pages {
                 if p.stale.is_empty() {

@@ -1,7 +1,7 @@
 //! Instruction counts of the benchmark firmware (`boards/bench`) under QEMU: the
 //! `qemu-insn-count` plugin counts the instructions of every call of the functions named in
 //! [`MEASURED`] (or [`MEASURED_PEAK_VALLEY`]), found by their symbols in the ELF; this module
-//! runs QEMU with it and reads the counts back. [`crate::cost`] writes the report.
+//! runs QEMU with it and reads the counts back. [`crate::cost::report`] writes the report.
 
 use std::collections::HashMap;
 use std::fmt::Write as _;
@@ -10,7 +10,7 @@ use std::path::Path;
 use anyhow::{bail, ensure, Context, Result};
 use object::{Object, ObjectSymbol, SymbolKind};
 
-use crate::qemu::{self, RunOptions};
+use crate::cost::qemu::{self, RunOptions};
 
 /// The functions whose calls are counted: (key, demangled name without hash). The
 /// `bench::` ones are the benchmark firmware's wrappers; the others are the core's

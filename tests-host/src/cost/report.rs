@@ -7,9 +7,9 @@
 //! * flash, static RAM and the stack's high-water mark of every firmware build;
 //! * host replay throughput (the criterion benchmark `benches/replay.rs`) next to gaitmap's
 //!   pipeline on the same trace (`tests-host/gaitmap/`);
-//! * the energy budget of the real boards ([`crate::energy`]) from the instruction counts.
+//! * the energy budget of the real boards ([`crate::cost::energy`]) from the instruction counts.
 //!
-//! The counting runs are [`crate::insn_count`]; this module builds the firmware, measures
+//! The counting runs are [`crate::cost::insn_count`]; this module builds the firmware, measures
 //! sizes and stacks, and writes the report.
 
 use std::fmt::Write as _;
@@ -19,9 +19,9 @@ use object::{Object, ObjectSection, SectionFlags};
 
 use gaitclip::pipeline::detectors::Detector;
 
-use crate::firmware::build_for;
-use crate::insn_count::{run_bench, run_bench_peak_valley, InsnReport, Stat, StepInsnReport};
-use crate::qemu::{self, RunOptions};
+use crate::cost::firmware::build_for;
+use crate::cost::insn_count::{run_bench, run_bench_peak_valley, InsnReport, Stat, StepInsnReport};
+use crate::cost::qemu::{self, RunOptions};
 
 /// Flash and static RAM of a firmware ELF, bytes.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -187,15 +187,15 @@ pub const BUILDS: [Build; 7] = [
 
 /// Measures everything and returns the Markdown report.
 pub fn report(inp: &Inputs) -> Result<String> {
-    use crate::trace::Ranges;
+    use crate::io::trace::Ranges;
     std::fs::create_dir_all(&inp.scratch)?;
     let (dataset, trial, rate_hz) = TRACE;
     let csv = inp.datasets.join(dataset).join(format!("{trial}.csv"));
-    let trace = crate::csv_trace::read(&csv, Some(rate_hz))?;
+    let trace = crate::io::csv_trace::read(&csv, Some(rate_hz))?;
     let ranges = Ranges::default();
     let counts: Vec<_> = trace.samples.iter().map(|s| ranges.to_counts(s)).collect();
     let name = format!("{dataset}_{trial}");
-    crate::fixtures::write_trace_module(
+    crate::sim::fixtures::write_trace_module(
         &inp.scratch,
         &name,
         &format!("`{dataset}/{trial}.csv` for the cost benchmark; written by `gaitclip cost`."),
@@ -222,7 +222,7 @@ pub fn report(inp: &Inputs) -> Result<String> {
         ),
         ("thumbv6m-none-eabi", qemu::MACHINE_M0, &[][..]),
     ] {
-        let elf = crate::firmware::build_with("boards/bench", "bench", target, args, &env)?;
+        let elf = crate::cost::firmware::build_with("boards/bench", "bench", target, args, &env)?;
         let r = run_bench(&elf, machine, &inp.plugin, &inp.scratch)?;
         ensure!(
             r.samples as usize == counts.len(),
@@ -524,7 +524,7 @@ fn render(r: &Report) -> String {
         verdict(ratio >= 100.0)
     );
     let _ = writeln!(o, "\n### Energy\n");
-    o.push_str(&crate::energy::report(
+    o.push_str(&crate::cost::energy::report(
         m4.sample_all_mean,
         m0.sample_all_mean,
     ));

@@ -5,7 +5,7 @@
 //! reach it) and again clipped: converted at the MPU6050's ±8 g and ±4 g ranges (the counts
 //! saturate), and as a part given as ±8 g that clips at 7 g: clamped there in physical units
 //! but converted at ±16 g, so that the rails sit inside the counts and must be learnt from the
-//! data ([`crate::rails`]). Each
+//! data ([`crate::io::rails`]). Each
 //! stride of a clipped replay that starts and ends at the same stance instants as a stride of
 //! the unclipped replay (clipping moved the others' instants: counted apart; what a moved
 //! instant takes from one stride it gives the next) has its ZUPT length compared with that
@@ -21,10 +21,10 @@ use anyhow::Result;
 use gaitclip::record::stride::{Stride, StrideFlags};
 use gaitclip::sensor::sample::{AccelRange, GyroRange, Rails, RawSample};
 
-use crate::datasets;
-use crate::markdown::{cm_cell, Table};
-use crate::trace::{Ranges, Trace, G_MPS2};
-use crate::{csv_trace, replay};
+use crate::eval::markdown::{cm_cell, Table};
+use crate::io::datasets;
+use crate::io::trace::{Ranges, Trace, G_MPS2};
+use crate::{io::csv_trace, replay};
 
 /// One way of clipping a recording.
 #[derive(Clone, Copy, Debug, PartialEq)]

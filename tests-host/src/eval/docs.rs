@@ -28,10 +28,10 @@ pub type Generator = fn(&Path) -> Result<String>;
 
 /// The commands a page may mark, and what prints their block.
 pub const GENERATORS: &[(&str, Generator)] = &[
-    ("clipping", crate::clip_sweep::report),
-    ("rates", crate::rate_sweep::report),
-    ("running", crate::running::report),
-    ("flags", crate::flag_costs::report),
+    ("clipping", crate::eval::clip_sweep::report),
+    ("rates", crate::eval::rate_sweep::report),
+    ("running", crate::eval::running::report),
+    ("flags", crate::eval::flag_costs::report),
 ];
 
 /// The subcommands of the `gaitclip` binary a marker may run as a whole command line: the

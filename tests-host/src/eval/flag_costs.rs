@@ -7,7 +7,7 @@
 //!
 //! **Made on purpose.** What a degradation does to a stride, against the same stride without
 //! it, on the walking strides of `gaitmap_walk` and `pyshoe_vicon` (every other one cut at a
-//! time, so that the estimate has measured neighbours, as [`crate::hole_sweep`] does):
+//! time, so that the estimate has measured neighbours, as [`crate::eval::hole_sweep`] does):
 //! a hole bridged (20 ms), a hole filled (60 ms: a gap stride, estimated), a hole after which
 //! detection restarts (300 ms: estimated), the accelerometer clipped (±8 g, ±4 g: restored),
 //! the gyro clipped (±500 °/s: restored); and the estimate itself as a predictor of every
@@ -18,13 +18,13 @@ use gaitclip::pipeline::config::BRIDGE_MAX_MS;
 use gaitclip::record::stride::{Stride, StrideFlags};
 use gaitclip::sensor::sample::{AccelRange, GyroRange};
 
-use crate::clip_sweep::{self, Clipping};
-use crate::datasets;
-use crate::hole_sweep::{self, Pattern};
-use crate::markdown::{cm_cell, Table};
-use crate::matching::{self, Detected, Scored};
-use crate::trace::Ranges;
-use crate::{csv_trace, replay};
+use crate::eval::clip_sweep::{self, Clipping};
+use crate::eval::hole_sweep::{self, Pattern};
+use crate::eval::markdown::{cm_cell, Table};
+use crate::eval::matching::{self, Detected, Scored};
+use crate::io::datasets;
+use crate::io::trace::Ranges;
+use crate::{io::csv_trace, replay};
 
 /// Every flag, in bit order, with what it does to the length.
 pub const FLAGS: [(u16, &str, &str); 12] = [

@@ -2,7 +2,7 @@
 //! that have them.
 //!
 //! Strides are the core's (the default configuration, as the firmware runs), matched to the
-//! reference strides as `gaitclip eval` matches them ([`crate::matching`]); only clean matched
+//! reference strides as `gaitclip eval` matches them ([`crate::eval::matching`]); only clean matched
 //! strides are compared.
 //!
 //! - **Times** (`gaitmap_walk`, `ipol_gait_events`): the reference stride time is heel-strike
@@ -29,12 +29,12 @@ use anyhow::Result;
 use gaitclip::record::gait::Gait;
 use gaitclip::record::stride::Stride;
 
-use crate::csv_trace;
-use crate::datasets::{Dataset, Trial};
-use crate::matching::{classify, Detected, Scored};
+use crate::eval::matching::{classify, Detected, Scored};
+use crate::eval::stats::{abs_quantile, median};
+use crate::io::csv_trace;
+use crate::io::datasets::{Dataset, Trial};
+use crate::io::trace::Ranges;
 use crate::replay;
-use crate::stats::{abs_quantile, median};
-use crate::trace::Ranges;
 
 /// Vicon speed above which a `pyshoe_vicon` stride is a run, m/s (the bound).
 pub const RUNNING_OVER_M_S: f64 = 2.5;
@@ -101,7 +101,7 @@ pub fn evaluate(dataset: &Dataset) -> Result<GaitResult> {
 fn compare_trial(
     dataset: &Dataset,
     trial: &Trial,
-    clock: &crate::clock::SampleClock,
+    clock: &crate::io::clock::SampleClock,
     strides: &[Stride],
     out: &mut GaitResult,
 ) {

@@ -24,7 +24,7 @@
 //! hole up to it keeps the mean |length difference| of every pattern and place within
 //! [`MEAN_LENGTH_BOUND_M`].
 
-use crate::stats::quantile;
+use crate::eval::stats::quantile;
 use std::fmt::Write as _;
 use std::path::Path;
 
@@ -33,11 +33,11 @@ use gaitclip::pipeline::config::{Config, FILL_MAX_MS};
 use gaitclip::record::stride::{Stride, StrideFlags};
 use gaitclip::sensor::sample::RawSample;
 
-use crate::clock::Gap;
-use crate::datasets;
-use crate::matching::{self, Detected};
-use crate::trace::{Ranges, Trace};
-use crate::{csv_trace, replay};
+use crate::eval::matching::{self, Detected};
+use crate::io::clock::Gap;
+use crate::io::datasets;
+use crate::io::trace::{Ranges, Trace};
+use crate::{io::csv_trace, replay};
 
 /// Longest hole cut, samples.
 pub const MAX_HOLE: u32 = 16;

@@ -17,7 +17,7 @@
 //!
 //! Per model and dataset: RMSE, MAE and bias (predicted − reference) over matched clean
 //! strides (reference unflagged, stride valid, and no second movement inside the
-//! reference's borders: see [`crate::matching::Scored::Unbordered`]), the same by stride speed
+//! reference's borders: see [`crate::eval::matching::Scored::Unbordered`]), the same by stride speed
 //! (reference length over reference duration) and by stride length, and the walked-distance
 //! error per trial, `|Σ predicted − Σ reference| / Σ reference` over all the core's strides
 //! in the trial's span where the trial's walked distance is known (`gaitmap_walk`: its
@@ -31,11 +31,11 @@ use std::fmt::Write as _;
 use anyhow::Result;
 use gaitclip::length::models::{self, Model, ModelParams, MODELS};
 
-use crate::cross_validation;
-use crate::fit::{self, HyperSet, Sample, Trained};
-use crate::plot::{Plot, COLOURS};
-use crate::stats::median;
-use crate::training_set::{self, TrialRun, TRAINING_DATASETS};
+use crate::eval::plot::{Plot, COLOURS};
+use crate::eval::stats::median;
+use crate::train::cross_validation;
+use crate::train::fit::{self, HyperSet, Sample, Trained};
+use crate::train::training_set::{self, TrialRun, TRAINING_DATASETS};
 
 /// Predictions of every model for every stride of every run: `[run][stride][model]`, m.
 pub type Predictions = Vec<Vec<[f64; MODELS]>>;

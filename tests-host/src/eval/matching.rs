@@ -1,9 +1,9 @@
 //! Detected strides against reference strides: one-to-one matching by overlap, the
 //! classification of each detection, and the tallies (detection, events, phases, stance)
-//! that [`crate::eval`] sums and [`crate::tables`] writes.
+//! that [`crate::eval::scoring`] sums and [`crate::eval::tables`] writes.
 
-use crate::clock::SampleClock;
-use crate::datasets::{Reference, Trial};
+use crate::io::clock::SampleClock;
+use crate::io::datasets::{Reference, Trial};
 
 /// One detected stride, in sample indices of its trial.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]

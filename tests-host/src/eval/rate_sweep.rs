@@ -2,7 +2,7 @@
 //! strides is measured rather than assumed.
 //!
 //! Each recording is replayed at its own rate and decimated by 2, 4 and 8
-//! ([`crate::resample`]: anti-aliased, as a slower sensor would record it): `esangeni_run`
+//! ([`crate::io::resample`]: anti-aliased, as a slower sensor would record it): `esangeni_run`
 //! from 800 Hz to 400, 200 and 100 Hz, `gaitmap_walk` and `pyshoe_vicon` from ≈ 200 Hz to
 //! 100 and 50 Hz. Every stride of a decimated replay is matched to the stride of the
 //! full-rate replay it overlaps most in time (at least half of both), and their lengths and
@@ -18,13 +18,13 @@
 
 use anyhow::Result;
 
-use crate::csv_trace;
-use crate::datasets;
-use crate::markdown::{cm_cell, Table};
+use crate::eval::markdown::{cm_cell, Table};
+use crate::eval::stats::median;
+use crate::io::csv_trace;
+use crate::io::datasets;
+use crate::io::resample::decimate;
+use crate::io::trace::{Ranges, Trace};
 use crate::replay::{self, StrideReport};
-use crate::resample::decimate;
-use crate::stats::median;
-use crate::trace::{Ranges, Trace};
 
 /// One recording at one rate against itself at its own rate.
 #[derive(Clone, Debug, Default, PartialEq)]

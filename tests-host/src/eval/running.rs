@@ -18,13 +18,13 @@ use anyhow::Result;
 use gaitclip::record::gait::Gait;
 use gaitclip::record::stride::StrideFlags;
 
-use crate::datasets;
-use crate::length_eval::SPEED_BINS;
-use crate::markdown::{cm_cell, Table};
-use crate::matching::{self, Detected, Scored};
-use crate::stats::median;
-use crate::trace::Ranges;
-use crate::{csv_trace, replay};
+use crate::eval::length_eval::SPEED_BINS;
+use crate::eval::markdown::{cm_cell, Table};
+use crate::eval::matching::{self, Detected, Scored};
+use crate::eval::stats::median;
+use crate::io::datasets;
+use crate::io::trace::Ranges;
+use crate::{io::csv_trace, replay};
 
 /// One matched stride at its stance instant (the stride's start).
 #[derive(Clone, Copy, Debug, PartialEq)]

@@ -2,7 +2,7 @@
 //! recordings in `../shared/datasets`.
 //!
 //! **Clock.** Everything is compared in the sensor clock's sample numbers, which the core
-//! counts (rows plus the periods lost in holes, [`crate::clock`]): a reference given as a
+//! counts (rows plus the periods lost in holes, [`crate::io::clock`]): a reference given as a
 //! row is mapped to its number, a reference given as a time (`ipol_gait_events`'
 //! `toe_off_s`/`heel_strike_s`, the walk bounds `walk_*_s`) to the number nearest it on the
 //! recovered clock. Event errors are then whole periods of the sensor, unaffected by holes.
@@ -34,18 +34,18 @@
 //! **Stance** (`pyshoe_vicon`): sample-wise F1 of "not inside a detected movement" against
 //! the Vicon stance label, over the labelled part of each trial.
 //!
-//! The datasets and their references are loaded by [`crate::datasets`], matched and scored by
-//! [`crate::matching`], and written as tables by [`crate::tables`].
+//! The datasets and their references are loaded by [`crate::io::datasets`], matched and scored by
+//! [`crate::eval::matching`], and written as tables by [`crate::eval::tables`].
 
 use anyhow::Result;
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 
-use crate::csv_trace;
-use crate::trace::{ImuSample, Ranges, Trace};
+use crate::io::csv_trace;
+use crate::io::trace::{ImuSample, Ranges, Trace};
 
-use crate::datasets::Dataset;
-use crate::matching::{score, Detected, Detections, Tally};
+use crate::eval::matching::{score, Detected, Detections, Tally};
+use crate::io::datasets::Dataset;
 
 /// A rotation matrix drawn uniformly (from a random unit quaternion).
 pub fn random_rotation(rng: &mut impl Rng) -> [[f64; 3]; 3] {

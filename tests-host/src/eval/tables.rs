@@ -5,13 +5,13 @@ use std::fmt::Write as _;
 
 use anyhow::{Context, Result};
 
-use crate::csv_trace;
-use crate::trace::Ranges;
+use crate::io::csv_trace;
+use crate::io::trace::Ranges;
 
-use crate::datasets::Dataset;
-use crate::eval::DatasetResult;
-use crate::matching::{mean, ratio, PhaseTally, Tally};
-use crate::stats::{abs_quantile, median};
+use crate::eval::matching::{mean, ratio, PhaseTally, Tally};
+use crate::eval::scoring::DatasetResult;
+use crate::eval::stats::{abs_quantile, median};
+use crate::io::datasets::Dataset;
 
 fn fmt3(v: f64) -> String {
     if v.is_nan() {

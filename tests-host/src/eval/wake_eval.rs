@@ -24,8 +24,8 @@ use gaitclip::pipeline::Pipeline;
 use gaitclip_board::replay_mpu6050::{mg_to_counts, motion_between, REPLAY_MOTION_UNIT};
 use gaitclip_board::sleep::SLEEP;
 
-use crate::datasets;
-use crate::trace::Ranges;
+use crate::io::datasets;
+use crate::io::trace::Ranges;
 
 /// Stands shorter than this are not looked at (a walking stance lasts under 1 s).
 pub const MIN_STAND_S: f64 = 2.0;
@@ -71,7 +71,7 @@ pub fn evaluate_at(dir: &Path, threshold_mg: u32) -> Result<WakeResult> {
     let ranges = Ranges::default();
     let threshold = mg_to_counts(threshold_mg, ranges.accel.afs_sel());
     for trial in &ds.trials {
-        let trace = crate::csv_trace::read(&trial.csv, Some(ds.rate_hz))
+        let trace = crate::io::csv_trace::read(&trial.csv, Some(ds.rate_hz))
             .with_context(|| trial.csv.display().to_string())?;
         let rate = trace.sample_rate().context("trace rate")?;
         let counts: Vec<_> = trace.samples.iter().map(|s| ranges.to_counts(s)).collect();

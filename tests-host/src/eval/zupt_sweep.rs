@@ -23,11 +23,11 @@ use gaitclip::length::models::Model;
 use gaitclip::record::stride::StrideFlags;
 use gaitclip::sensor::sample::{AccelRange, GyroRange};
 
-use crate::datasets;
-use crate::length_eval::SPEED_BINS;
-use crate::matching::{self, Detected, Scored};
-use crate::trace::Ranges;
-use crate::{csv_trace, replay};
+use crate::eval::length_eval::SPEED_BINS;
+use crate::eval::matching::{self, Detected, Scored};
+use crate::io::datasets;
+use crate::io::trace::Ranges;
+use crate::{io::csv_trace, replay};
 
 /// Sensor heights swept, mm.
 pub const HEIGHTS_MM: [u32; 6] = [0, 40, 60, 80, 100, 120];

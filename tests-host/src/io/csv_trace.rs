@@ -5,7 +5,7 @@ use std::fs;
 use std::io::Write;
 use std::path::{Path, PathBuf};
 
-use crate::trace::{ImuSample, Trace};
+use crate::io::trace::{ImuSample, Trace};
 
 /// The columns, in the order the datasets write them.
 pub const COLUMNS: [&str; 7] = ["t_s", "acc_x", "acc_y", "acc_z", "gyr_x", "gyr_y", "gyr_z"];
@@ -91,7 +91,7 @@ pub enum CsvError {
 
 /// Reads a CSV trace. The nominal rate comes from `rate_hz` if given, else from a
 /// `meta.json` beside the file (`sample_rate_hz`), else from the stamps
-/// ([`crate::clock::nominal_period`]). Re-sent samples (a stamp equal to the one before, or
+/// ([`crate::io::clock::nominal_period`]). Re-sent samples (a stamp equal to the one before, or
 /// earlier by less than half a period) are dropped and counted in [`Trace::repeated`].
 pub fn read(path: &Path, rate_hz: Option<f64>) -> Result<Trace, CsvError> {
     let text = fs::read(path).map_err(|source| CsvError::Io {
@@ -120,7 +120,7 @@ pub fn read(path: &Path, rate_hz: Option<f64>) -> Result<Trace, CsvError> {
 
 /// The nominal ranges `acc_range_g` and `gyro_range_dps` of a `meta.json` beside the file,
 /// where it gives them.
-fn meta_ranges(csv: &Path) -> Result<crate::trace::GivenRanges, CsvError> {
+fn meta_ranges(csv: &Path) -> Result<crate::io::trace::GivenRanges, CsvError> {
     let meta = csv.with_file_name("meta.json");
     let Ok(text) = fs::read_to_string(&meta) else {
         return Ok(Default::default());
@@ -140,7 +140,7 @@ fn meta_ranges(csv: &Path) -> Result<crate::trace::GivenRanges, CsvError> {
                 message: format!("{name} is not a positive number: {r}"),
             }),
     };
-    Ok(crate::trace::GivenRanges {
+    Ok(crate::io::trace::GivenRanges {
         acc_g: field("acc_range_g")?,
         gyro_dps: field("gyro_range_dps")?,
     })

@@ -7,7 +7,7 @@ use std::path::{Path, PathBuf};
 use anyhow::{bail, Context, Result};
 use serde::Deserialize;
 
-use crate::clock::SampleClock;
+use crate::io::clock::SampleClock;
 
 /// The datasets folder beside the repository, if present.
 pub fn root() -> Option<PathBuf> {

@@ -8,8 +8,8 @@ use std::path::{Path, PathBuf};
 
 use serde::{Deserialize, Serialize};
 
+use crate::io::trace::{ImuSample, Trace};
 use crate::replay::StrideReport;
-use crate::trace::{ImuSample, Trace};
 
 /// Schema name of gaitclip's own IMU messages (JSON).
 pub const IMU_SCHEMA: &str = "gaitclip.ImuSample";

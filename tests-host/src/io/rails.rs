@@ -16,7 +16,7 @@
 use gaitclip::sensor::sample::{AxisRails, Rails};
 use serde::Serialize;
 
-use crate::trace::{GivenRanges, ImuSample, Ranges, G_MPS2};
+use crate::io::trace::{GivenRanges, ImuSample, Ranges, G_MPS2};
 
 /// A sample within this share of an axis's extreme value sits on the plateau (a real part's
 /// rail wanders by ±0.3 % with the other axes' cross-coupling: `esangeni_run`).

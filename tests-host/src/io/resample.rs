@@ -12,7 +12,7 @@
 //! around it and the 200 Hz sample there lies below the rail, unclipped to the core, as it
 //! would in a sensor that filters before it decimates. `gaitclip rates` shows what that costs.
 
-use crate::trace::{ImuSample, Trace};
+use crate::io::trace::{ImuSample, Trace};
 
 /// The filter's taps for decimation by `k` (sum 1).
 pub fn taps(k: usize) -> Vec<f64> {

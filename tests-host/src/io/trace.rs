@@ -24,13 +24,13 @@ pub struct Trace {
     /// The samples, in time order.
     pub samples: Vec<ImuSample>,
     /// Nominal sample rate, Hz (`--rate`, `meta.json`, or estimated from the stamps); the
-    /// replay recovers the sensor's own clock from the stamps ([`crate::clock`]).
+    /// replay recovers the sensor's own clock from the stamps ([`crate::io::clock`]).
     pub rate_hz: f64,
     /// Samples dropped by the reader as re-sent: a stamp equal to the one before, or
-    /// earlier by less than half a period ([`crate::clock::drop_repeats`]).
+    /// earlier by less than half a period ([`crate::io::clock::drop_repeats`]).
     pub repeated: usize,
     /// The sensor's nominal ranges, where known (`--acc-range-g`, `--gyro-range-dps`,
-    /// `meta.json`): the rails where no flat run shows others ([`crate::rails`]).
+    /// `meta.json`): the rails where no flat run shows others ([`crate::io::rails`]).
     pub given: GivenRanges,
 }
 
@@ -93,25 +93,25 @@ impl Trace {
         SampleRate::from_millihertz((self.rate_hz * 1000.0).round() as u32)
     }
 
-    /// Estimates the nominal rate from the stamps ([`crate::clock::nominal_period`]).
+    /// Estimates the nominal rate from the stamps ([`crate::io::clock::nominal_period`]).
     pub fn rate_from_timestamps(samples: &[ImuSample]) -> Option<f64> {
         let t: Vec<f64> = samples.iter().map(|s| s.t_s).collect();
-        crate::clock::nominal_period(&t).map(|p| 1.0 / p)
+        crate::io::clock::nominal_period(&t).map(|p| 1.0 / p)
     }
 
-    /// Drops re-sent samples ([`crate::clock::drop_repeats`] at the nominal rate, or at
+    /// Drops re-sent samples ([`crate::io::clock::drop_repeats`] at the nominal rate, or at
     /// the rate the stamps suggest when it is not known yet), counting them in
     /// [`Trace::repeated`]. On a stamp that goes back further, the index of its sample.
     pub fn drop_repeats(
         samples: Vec<ImuSample>,
         rate_hz: Option<f64>,
-    ) -> Result<(Vec<ImuSample>, usize), crate::clock::TimeGoesBack> {
+    ) -> Result<(Vec<ImuSample>, usize), crate::io::clock::TimeGoesBack> {
         let t: Vec<f64> = samples.iter().map(|s| s.t_s).collect();
         let period = match rate_hz {
             Some(r) if r > 0.0 => 1.0 / r,
-            _ => crate::clock::nominal_period(&t).unwrap_or(0.0),
+            _ => crate::io::clock::nominal_period(&t).unwrap_or(0.0),
         };
-        let keep = crate::clock::drop_repeats(&t, period)?;
+        let keep = crate::io::clock::drop_repeats(&t, period)?;
         let dropped = samples.len() - keep.len();
         if dropped == 0 {
             return Ok((samples, 0));

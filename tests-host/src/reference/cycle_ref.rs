@@ -18,7 +18,7 @@ use gaitclip::record::stride::{Stride, StrideFlags};
 use gaitclip::sensor::sample::{AxisRails, RawSample};
 use nalgebra::{UnitQuaternion, Vector3};
 
-use crate::clock::Gap;
+use crate::io::clock::Gap;
 
 /// Standard gravity, m/s².
 const G: f64 = 9.806_65;

@@ -22,8 +22,8 @@ use gaitclip::sensor::rate::SampleRate;
 use gaitclip::sensor::sample::RawSample;
 use nalgebra::{Matrix3, SymmetricEigen, Vector3};
 
-use crate::matching::Detected;
-use crate::trace::G_MPS2;
+use crate::eval::matching::Detected;
+use crate::io::trace::G_MPS2;
 
 /// Runs the reference over raw counts; strides in the order the core reports them.
 pub fn strides(samples: &[RawSample], config: Config) -> Vec<Detected> {

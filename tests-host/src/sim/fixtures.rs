@@ -6,9 +6,9 @@ use std::path::Path;
 
 use anyhow::Context;
 
-use crate::csv_trace;
-use crate::sim::{self, Scenario};
-use crate::trace::Ranges;
+use crate::io::csv_trace;
+use crate::io::trace::Ranges;
+use crate::sim::gait_sim::{self, Scenario};
 
 /// The scenario the emulated board replays from flash.
 pub const FIRMWARE_TRACE: &str = "demo_walk";
@@ -29,7 +29,7 @@ pub fn firmware_trace_counts() -> std::io::Result<Vec<gaitclip::sensor::sample::
 /// Every file [`write_all`] writes, for the staleness test.
 pub fn file_names() -> Vec<String> {
     let mut v = Vec::new();
-    for sc in sim::scenarios() {
+    for sc in gait_sim::scenarios() {
         for ext in ["csv", "truth.csv", "json"] {
             v.push(format!("{}.{ext}", sc.name));
         }
@@ -43,14 +43,14 @@ pub fn file_names() -> Vec<String> {
 pub fn write_all(dir: &Path) -> anyhow::Result<()> {
     fs::create_dir_all(dir).with_context(|| format!("creating {}", dir.display()))?;
     let ranges = Ranges::default();
-    for sc in sim::scenarios() {
+    for sc in gait_sim::scenarios() {
         write_one(dir, &sc, ranges)?;
     }
     Ok(())
 }
 
 fn write_one(dir: &Path, sc: &Scenario, ranges: Ranges) -> anyhow::Result<()> {
-    let out = sim::simulate(sc, ranges);
+    let out = gait_sim::simulate(sc, ranges);
     let path = |ext: &str| dir.join(format!("{}.{ext}", sc.name));
     let mut csv = Vec::new();
     csv_trace::write(&mut csv, &out.samples)?;
@@ -67,7 +67,7 @@ fn write_one(dir: &Path, sc: &Scenario, ranges: Ranges) -> anyhow::Result<()> {
         "scenario": sc,
         "accel_range_g": 16,
         "gyro_range_dps": 2000,
-        "ground_truth": "<name>.truth.csv: indices are 0-based rows of <name>.csv; a stride runs from the foot-flat that starts its stance (start_idx) to the next foot-flat (end_idx); heel_off/toe_off/heel_strike are the simulator's gait events (see tests-host/src/sim.rs); length_m is the horizontal foot displacement",
+        "ground_truth": "<name>.truth.csv: indices are 0-based rows of <name>.csv; a stride runs from the foot-flat that starts its stance (start_idx) to the next foot-flat (end_idx); heel_off/toe_off/heel_strike are the simulator's gait events (see tests-host/src/sim/gait_sim.rs); length_m is the horizontal foot displacement",
     }))?;
     json.push('\n');
     fs::write(path("json"), json)?;

@@ -28,7 +28,7 @@ use rand_chacha::ChaCha8Rng;
 use rand_distr::{Distribution, Normal};
 use serde::Serialize;
 
-use crate::trace::{ImuSample, Ranges, G_MPS2};
+use crate::io::trace::{ImuSample, Ranges, G_MPS2};
 
 /// τ of toe-off within the movement.
 pub const TOE_OFF_TAU: f64 = 0.15;

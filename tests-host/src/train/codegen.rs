@@ -6,9 +6,9 @@ use std::fmt::Write as _;
 use gaitclip::length::features::{self};
 use gaitclip::length::models::Model;
 
-use crate::fit::{terms, SvrQ, SLOTS};
-use crate::train::Training;
-use crate::training_set::TRAINING_DATASETS;
+use crate::train::fit::{terms, SvrQ, SLOTS};
+use crate::train::training::Training;
+use crate::train::training_set::TRAINING_DATASETS;
 
 /// `#[cfg]` line of the tables of a model that only builds with the `all-models` feature
 /// (every SVR model but the pipeline's default), or nothing.

@@ -6,7 +6,7 @@ use std::collections::BTreeMap;
 use anyhow::Result;
 use gaitclip::detect::phase_stats::Segment;
 
-use crate::fit::{fit_svr, select, Hyper, HyperSet, Sample, SLOTS};
+use crate::train::fit::{fit_svr, select, Hyper, HyperSet, Sample, SLOTS};
 
 /// Folds of the grouped cross-validation.
 pub const FOLDS: usize = 5;

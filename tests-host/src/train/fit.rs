@@ -17,7 +17,7 @@ use ndarray::{Array1, Array2};
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 
-use crate::length_ref;
+use crate::reference::length_ref;
 
 /// Features per SVR chosen from its segment (the ZUPT displacement is added to them).
 pub const SELECTED: usize = 8;
@@ -323,8 +323,8 @@ fn lu_range(train: &[&Sample]) -> (f64, f64) {
     let i = features::index(Segment::Movement, Channel::Vertical, features::Stat::Range);
     let r: Vec<f64> = train.iter().map(|s| s.x[i]).collect();
     (
-        crate::stats::quantile_at_rounded_index(&r, 0.05),
-        crate::stats::quantile_at_rounded_index(&r, 0.95),
+        crate::eval::stats::quantile_at_rounded_index(&r, 0.05),
+        crate::eval::stats::quantile_at_rounded_index(&r, 0.95),
     )
 }
 

@@ -3,7 +3,7 @@
 //!
 //! Data: the core's strides on `pyshoe_vicon` and `gaitmap_walk`, matched to their
 //! reference strides; a stride trains only when its reference is clean (unflagged) and the
-//! core marked it valid. Features are the f64 reference features ([`crate::length_ref`]).
+//! core marked it valid. Features are the f64 reference features ([`crate::reference::length_ref`]).
 //!
 //! - Closed-form models: least squares (SVD) on their basis terms.
 //! - SVRs (`linfa-svm`, ε-SVR, RBF kernel): inputs are the [`SELECTED`] features of their
@@ -15,17 +15,17 @@
 //! - SVR-AdaBoost: AdaBoost.R2 (Drucker 1997, linear loss) with [`BOOST_ROUNDS`] members per
 //!   phase, each fit on a weighted resample (seeded ChaCha8, so training is repeatable).
 //!
-//! This module gathers the training strides and runs the steps: [`crate::fit`] fits,
-//! [`crate::cross_validation`] chooses the SVRs' hyper-parameters, [`crate::codegen`] writes
+//! This module gathers the training strides and runs the steps: [`crate::train::fit`] fits,
+//! [`crate::train::cross_validation`] chooses the SVRs' hyper-parameters, [`crate::train::codegen`] writes
 //! the source.
 
 use anyhow::Result;
 use gaitclip::length::models::Model;
 
-use crate::cross_validation::{choose_hyper, folds};
-use crate::fit::{fit_all, HyperSet, Sample, Trained};
-use crate::length_eval;
-use crate::training_set::{samples, TrialRun};
+use crate::eval::length_eval;
+use crate::train::cross_validation::{choose_hyper, folds};
+use crate::train::fit::{fit_all, HyperSet, Sample, Trained};
+use crate::train::training_set::{samples, TrialRun};
 
 /// What `gaitclip train` produces: the models and how they were chosen.
 pub struct Training {

@@ -1,7 +1,7 @@
 //! The training set: the core's strides on the datasets with per-stride lengths
 //! (`pyshoe_vicon`, `gaitmap_walk`), matched to their reference strides, with the f64
-//! reference features ([`crate::length_ref`]) of each. Both the training ([`crate::train`])
-//! and the evaluation of the models ([`crate::length_eval`]) read it; neither is read here.
+//! reference features ([`crate::reference::length_ref`]) of each. Both the training ([`crate::train::training`])
+//! and the evaluation of the models ([`crate::eval::length_eval`]) read it; neither is read here.
 //!
 //! A stride trains only when its reference is clean (unflagged) and the core marked it valid.
 
@@ -14,12 +14,12 @@ use gaitclip::length::models::Settings;
 use gaitclip::record::stride::Stride;
 use gaitclip::sensor::rate::SampleRate;
 
-use crate::datasets::{self, Dataset};
-use crate::fit::Sample;
-use crate::length_ref;
-use crate::matching::{self, Detected};
-use crate::trace::Ranges;
-use crate::{csv_trace, replay};
+use crate::eval::matching::{self, Detected};
+use crate::io::datasets::{self, Dataset};
+use crate::io::trace::Ranges;
+use crate::reference::length_ref;
+use crate::train::fit::Sample;
+use crate::{io::csv_trace, replay};
 
 /// Datasets with per-stride lengths, the training data.
 pub const TRAINING_DATASETS: [&str; 2] = ["gaitmap_walk", "pyshoe_vicon"];

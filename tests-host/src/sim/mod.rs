@@ -1,0 +1,4 @@
+//! The gait simulator and the fixtures it writes.
+
+pub mod fixtures;
+pub mod gait_sim;
