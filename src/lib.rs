@@ -10,7 +10,8 @@
 //! through a fixed chain of stages, in this order, each fed only the records of the stage
 //! before it:
 //!
-//! 1. [`mpu6050`] — the driver: one burst read per sample into a [`sensor::sample::RawSample`]
+//! 1. [`mpu6050`] — the driver, its own crate (`drivers/mpu6050`, [`gaitclip_mpu6050`]): one
+//!    burst read per sample into a [`sensor::sample::RawSample`]
 //!    of counts. Nothing later looks at a register.
 //! 2. [`signal::mean_filter`] — a moving average over a power-of-two ring with a running sum.
 //! 3. [`detect::foot_frame`] — which way is up (gravity in the rests that the orientation-free
@@ -90,7 +91,9 @@
 //! | [`gait`] | the gait parameters of a stride |
 //! | [`pipeline`] | the configuration, the detector list, and the composition of it all |
 //!
-//! The driver, [`mpu6050`], sits beside them: nothing in the chain imports it.
+//! The driver, [`mpu6050`], is a crate of its own that knows nothing of gaitclip: the core
+//! depends on it only for its records (the sample, the ranges), which [`sensor::sample`]
+//! re-exports; no stage calls it, the boards do.
 //!
 //! ## Units
 //!
@@ -106,7 +109,8 @@ pub mod detect;
 pub mod fixed;
 pub mod gait;
 pub mod length;
-pub mod mpu6050;
+/// The driver, its own crate ([`gaitclip_mpu6050`]), under the name the chain's table uses.
+pub use gaitclip_mpu6050 as mpu6050;
 pub mod pipeline;
 pub mod record;
 pub mod sensor;

@@ -41,7 +41,7 @@ for dir in "$root"/boards/*/; do
   echo "-- ${dir#"$root"/}"
   (cd "$dir" && cargo clippy --release -- -D warnings && cargo build --release)
 done
-cargo clippy --release -p gaitclip --target thumbv6m-none-eabi -- -D warnings
+cargo clippy --release -p gaitclip -p gaitclip-mpu6050 --target thumbv6m-none-eabi -- -D warnings
 
 echo "== tests-host (and the qemu-insn-count plugin): rustfmt, clippy, tests"
 cd "$root/tests-host"

@@ -37,6 +37,7 @@ use gaitclip::pipeline::Pipeline;
 use gaitclip::record::stride::Stride;
 use gaitclip::sensor::rate::SampleRate;
 use gaitclip::sensor::sample::{AccelRange, GyroRange, RawSample, SAMPLE_BYTES};
+use gaitclip::sensor::units::{AccelScale, GyroScale};
 use gaitclip_board::Steps;
 use static_cell::ConstStaticCell;
 
@@ -58,8 +59,8 @@ const RATE: SampleRate = unwrap(SampleRate::from_millihertz(trace::RATE_MILLIHER
 const CONFIG: Config = {
     let mut c = Config::new(
         RATE,
-        unwrap(AccelRange::from_afs_sel(trace::ACCEL_AFS_SEL)).scale(),
-        unwrap(GyroRange::from_fs_sel(trace::GYRO_FS_SEL)).scale(),
+        AccelScale::of(unwrap(AccelRange::from_afs_sel(trace::ACCEL_AFS_SEL))),
+        GyroScale::of(unwrap(GyroRange::from_fs_sel(trace::GYRO_FS_SEL))),
     );
     c.detector = gaitclip_board::DETECTOR;
     c

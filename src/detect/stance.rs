@@ -321,7 +321,7 @@ mod tests {
         let rate = SampleRate::from_hz(200).unwrap();
         StanceDetector::new(StanceThresholds::new(
             rate,
-            crate::sensor::sample::GyroRange::Dps2000.scale(),
+            crate::sensor::units::GyroScale::of(crate::sensor::sample::GyroRange::Dps2000),
         ))
     }
 
@@ -342,7 +342,7 @@ mod tests {
     fn windows_are_centred_and_the_answer_waits_for_the_largest() {
         let t = StanceThresholds::new(
             SampleRate::from_hz(200).unwrap(),
-            crate::sensor::sample::GyroRange::Dps2000.scale(),
+            crate::sensor::units::GyroScale::of(crate::sensor::sample::GyroRange::Dps2000),
         );
         assert_eq!(t.half, [3, 6, 12]);
         assert_eq!(t.delay(), 12);

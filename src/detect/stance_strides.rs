@@ -651,7 +651,7 @@ mod tests {
         let rate = SampleRate::from_hz(RATE_HZ).unwrap();
         StrideTracker::sized(
             rate,
-            crate::sensor::sample::GyroRange::Dps2000.scale(),
+            crate::sensor::units::GyroScale::of(crate::sensor::sample::GyroRange::Dps2000),
             PhaseMethod::Augmented,
         )
     }

@@ -38,9 +38,9 @@ pub struct Config {
     /// Sample rate.
     pub rate: SampleRate,
     /// Accelerometer scale of the counts (counts per g; the MPU6050's from
-    /// [`crate::sensor::sample::AccelRange::scale`]).
+    /// [`crate::sensor::units::AccelScale::of`]).
     pub accel: AccelScale,
-    /// Gyroscope scale of the counts (counts per °/s; [`crate::sensor::sample::GyroRange::scale`]).
+    /// Gyroscope scale of the counts (counts per °/s; [`crate::sensor::units::GyroScale::of`]).
     pub gyro: GyroScale,
     /// Where each axis clips, counts ([`Rails::FULL_SCALE`] for the MPU6050; a replayed
     /// recording's are learnt from its data or given).

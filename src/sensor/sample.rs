@@ -1,185 +1,30 @@
-//! One raw MPU6050 sample as it comes off the bus, and the sensor's full-scale ranges.
+//! One raw MPU6050 sample as it comes off the bus and the sensor's full-scale ranges (the
+//! driver's records, [`gaitclip_mpu6050`]), the scale each range's counts are in for the stages
+//! ([`RangeScale`]), and where a reading clips ([`Rails`]).
+
+pub use gaitclip_mpu6050::{AccelRange, GyroRange, RawSample, SAMPLE_BYTES};
 
 use crate::sensor::units::{AccelScale, GyroScale};
 
-/// Accelerometer full-scale range (register `ACCEL_CONFIG.AFS_SEL`).
-///
-/// The default is ±16 g: heel strikes of a foot-mounted sensor exceed 8 g.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
-pub enum AccelRange {
-    /// ±2 g, 16384 LSB/g.
-    G2,
-    /// ±4 g, 8192 LSB/g.
-    G4,
-    /// ±8 g, 4096 LSB/g.
-    G8,
-    /// ±16 g, 2048 LSB/g.
-    #[default]
-    G16,
+/// The scale a range's counts are in, as the stages compute in it.
+pub trait RangeScale {
+    /// [`AccelScale`] or [`GyroScale`].
+    type Scale;
+    /// The scale of this range's counts.
+    fn scale(self) -> Self::Scale;
 }
 
-impl AccelRange {
-    /// The scale the stages compute in.
-    pub const fn scale(self) -> AccelScale {
-        AccelScale::from_lsb_per_g(self.lsb_per_g())
-    }
-
-    /// Counts per g (datasheet sensitivity).
-    pub const fn lsb_per_g(self) -> u32 {
-        16384 >> self.afs_sel()
-    }
-
-    /// The range for an `AFS_SEL` field value; `None` above 3.
-    pub const fn from_afs_sel(v: u8) -> Option<Self> {
-        match v {
-            0 => Some(AccelRange::G2),
-            1 => Some(AccelRange::G4),
-            2 => Some(AccelRange::G8),
-            3 => Some(AccelRange::G16),
-            _ => None,
-        }
-    }
-
-    /// The `AFS_SEL` field value (0..=3).
-    pub const fn afs_sel(self) -> u8 {
-        match self {
-            AccelRange::G2 => 0,
-            AccelRange::G4 => 1,
-            AccelRange::G8 => 2,
-            AccelRange::G16 => 3,
-        }
+impl RangeScale for AccelRange {
+    type Scale = AccelScale;
+    fn scale(self) -> AccelScale {
+        AccelScale::of(self)
     }
 }
 
-/// Gyroscope full-scale range (register `GYRO_CONFIG.FS_SEL`).
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
-pub enum GyroRange {
-    /// ±250 °/s, 131 LSB/(°/s).
-    Dps250,
-    /// ±500 °/s, 65.5 LSB/(°/s).
-    Dps500,
-    /// ±1000 °/s, 32.8 LSB/(°/s).
-    Dps1000,
-    /// ±2000 °/s, 16.4 LSB/(°/s). Swing of a fast walk reaches ~800 °/s, running more.
-    #[default]
-    Dps2000,
-}
-
-impl GyroRange {
-    /// The scale the stages compute in.
-    pub const fn scale(self) -> GyroScale {
-        GyroScale::from_lsb_per_dps_x10(self.lsb_per_dps_x10())
-    }
-
-    /// Counts per (°/s), times ten, so that every range is an integer (131.0 → 1310).
-    pub const fn lsb_per_dps_x10(self) -> u32 {
-        match self {
-            GyroRange::Dps250 => 1310,
-            GyroRange::Dps500 => 655,
-            GyroRange::Dps1000 => 328,
-            GyroRange::Dps2000 => 164,
-        }
-    }
-
-    /// An angular rate in mrad/s as counts of this range, rounded (exact to ±0.5 count
-    /// plus 1 ppm for π; any `mrad_per_s` up to 10⁶, 1 000 rad/s).
-    pub const fn counts_of_mrad_per_s(self, mrad_per_s: u32) -> u32 {
-        self.scale().counts_of_mrad_per_s(mrad_per_s)
-    }
-
-    /// The range for an `FS_SEL` field value; `None` above 3.
-    pub const fn from_fs_sel(v: u8) -> Option<Self> {
-        match v {
-            0 => Some(GyroRange::Dps250),
-            1 => Some(GyroRange::Dps500),
-            2 => Some(GyroRange::Dps1000),
-            3 => Some(GyroRange::Dps2000),
-            _ => None,
-        }
-    }
-
-    /// The `FS_SEL` field value (0..=3).
-    pub const fn fs_sel(self) -> u8 {
-        match self {
-            GyroRange::Dps250 => 0,
-            GyroRange::Dps500 => 1,
-            GyroRange::Dps1000 => 2,
-            GyroRange::Dps2000 => 3,
-        }
-    }
-}
-
-/// Number of bytes of one sample in the sensor's register layout (0x3B..=0x48) and FIFO.
-pub const SAMPLE_BYTES: usize = 14;
-
-/// One sample in raw sensor counts, sensor axes.
-///
-/// `accel` is specific force (gravity included) in counts of the configured [`AccelRange`],
-/// `gyro` angular rate in counts of the configured [`GyroRange`], `temp` the raw temperature
-/// register (°C = temp / 340 + 36.53).
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
-pub struct RawSample {
-    /// Accelerometer x, y, z in counts.
-    pub accel: [i16; 3],
-    /// Gyroscope x, y, z in counts.
-    pub gyro: [i16; 3],
-    /// Temperature register.
-    pub temp: i16,
-}
-
-impl RawSample {
-    /// Decodes the big-endian register block `ACCEL_XOUT_H..=GYRO_ZOUT_L` (also the FIFO
-    /// layout when accel, temperature and gyro are enabled).
-    pub const fn from_be_bytes(b: &[u8; SAMPLE_BYTES]) -> Self {
-        RawSample {
-            accel: [word(b, 0), word(b, 1), word(b, 2)],
-            temp: word(b, 3),
-            gyro: [word(b, 4), word(b, 5), word(b, 6)],
-        }
-    }
-
-    /// Encodes in the register layout; the inverse of [`RawSample::from_be_bytes`].
-    pub const fn to_be_bytes(&self) -> [u8; SAMPLE_BYTES] {
-        let words = [
-            self.accel[0],
-            self.accel[1],
-            self.accel[2],
-            self.temp,
-            self.gyro[0],
-            self.gyro[1],
-            self.gyro[2],
-        ];
-        let mut out = [0u8; SAMPLE_BYTES];
-        let mut i = 0;
-        while i < 7 {
-            let [h, l] = words[i].to_be_bytes();
-            out[2 * i] = h;
-            out[2 * i + 1] = l;
-            i += 1;
-        }
-        out
-    }
-
-    /// True if a gyroscope axis sits at a rail of its range.
-    pub const fn gyro_saturated(&self) -> bool {
-        rail(self.gyro[0]) || rail(self.gyro[1]) || rail(self.gyro[2])
-    }
-
-    /// True if an accelerometer axis sits at a rail of its range.
-    pub const fn accel_saturated(&self) -> bool {
-        rail(self.accel[0]) || rail(self.accel[1]) || rail(self.accel[2])
-    }
-
-    /// True if any axis sits at a rail of its range (the true value may be beyond it).
-    pub const fn is_saturated(&self) -> bool {
-        let mut i = 0;
-        while i < 3 {
-            if rail(self.accel[i]) || rail(self.gyro[i]) {
-                return true;
-            }
-            i += 1;
-        }
-        false
+impl RangeScale for GyroRange {
+    type Scale = GyroScale;
+    fn scale(self) -> GyroScale {
+        GyroScale::of(self)
     }
 }
 
@@ -287,14 +132,6 @@ impl Rails {
         }
         bits
     }
-}
-
-const fn word(b: &[u8; SAMPLE_BYTES], i: usize) -> i16 {
-    i16::from_be_bytes([b[2 * i], b[2 * i + 1]])
-}
-
-const fn rail(v: i16) -> bool {
-    v == i16::MAX || v == i16::MIN
 }
 
 /// Where a sample fed to the tracker comes from: the sensor, or the pipeline's

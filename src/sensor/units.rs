@@ -1,8 +1,10 @@
 //! Units the stages compute in, as types: a sensor's scale (counts per g, per °/s) apart
 //! from the register values that set it, and the foot-frame acceleration every stage after
 //! the foot frame reads. The stages take these, not the MPU6050's range enums
-//! ([`crate::sensor::sample::AccelRange::scale`], [`crate::sensor::sample::GyroRange::scale`] convert), so
-//! another sensor needs only its own scale.
+//! ([`AccelScale::of`], [`GyroScale::of`] and [`crate::sensor::sample::RangeScale`] convert),
+//! so another sensor needs only its own scale.
+
+use gaitclip_mpu6050::{AccelRange, GyroRange};
 
 /// Foot-frame accelerations are in units of g/`FOOT_LSB_PER_G` whatever the sensor's range:
 /// 2048 counts per g, the MPU6050's ±16 g scale, so that ±16 g fits an `i16`.
@@ -20,6 +22,11 @@ impl AccelScale {
         AccelScale {
             lsb_per_g: if lsb_per_g == 0 { 1 } else { lsb_per_g },
         }
+    }
+
+    /// The scale of an MPU6050 range (its datasheet sensitivity).
+    pub const fn of(range: AccelRange) -> Self {
+        Self::from_lsb_per_g(range.lsb_per_g())
     }
 
     /// Counts per g.
@@ -45,6 +52,11 @@ impl GyroScale {
                 lsb_per_dps_x10
             },
         }
+    }
+
+    /// The scale of an MPU6050 range (its datasheet sensitivity).
+    pub const fn of(range: GyroRange) -> Self {
+        Self::from_lsb_per_dps_x10(range.lsb_per_dps_x10())
     }
 
     /// Counts per (°/s), times ten.

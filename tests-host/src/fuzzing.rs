@@ -2,6 +2,7 @@
 //! command replays their seed corpus and every crash ever found (`tests/fuzz_corpus.rs`)
 //! through exactly the code the fuzzer ran. Each one panics when an invariant breaks.
 
+use gaitclip::sensor::sample::RangeScale;
 use std::path::Path;
 
 use gaitclip::length::models::Model;

@@ -3,9 +3,11 @@
 
 use embedded_hal::i2c::{ErrorType, I2c, Operation};
 use embedded_hal_mock::eh1::delay::NoopDelay;
-use gaitclip::mpu6050::{Address, Config, Mpu6050, OutputRate};
+use gaitclip::mpu6050::blocking::Mpu6050;
+use gaitclip::mpu6050::{Address, Config, OutputRate};
 use gaitclip::pipeline::Pipeline;
 use gaitclip::sensor::rate::SampleRate;
+use gaitclip::sensor::sample::RangeScale;
 use gaitclip::sensor::sample::{AccelRange, GyroRange, RawSample};
 use gaitclip_board::{imu_sampler, replay_mpu6050, serial_line, startup};
 use imu_sampler::{BusRecovery, Counters, ImuSampler, Item, ReadMode};

@@ -8,10 +8,12 @@
 use embedded_hal::i2c::{ErrorKind, ErrorType, I2c, NoAcknowledgeSource, Operation};
 use embedded_hal_mock::eh1::delay::NoopDelay;
 use embedded_hal_mock::eh1::i2c::{Mock, Transaction as T};
-use gaitclip::mpu6050::{Address, Config, Mpu6050, OutputRate};
+use gaitclip::mpu6050::blocking::Mpu6050;
+use gaitclip::mpu6050::{Address, Config, OutputRate};
 use gaitclip::pipeline::Pipeline;
 use gaitclip::record::stride::{Stride, StrideFlags};
 use gaitclip::sensor::rate::SampleRate;
+use gaitclip::sensor::sample::RangeScale;
 use gaitclip::sensor::sample::{AccelRange, GyroRange};
 use gaitclip_board::imu_sampler;
 use imu_sampler::{BusRecovery, Counters, ImuSampler, Item, ReadMode, RESTART_AFTER, RETRIES};

@@ -5,6 +5,7 @@
 
 use gaitclip::pipeline::config::Config;
 use gaitclip::pipeline::detectors::Detector;
+use gaitclip::sensor::sample::RangeScale;
 use gaitclip_host::cost::firmware::{self, repo_root};
 use gaitclip_host::cost::insn_count;
 use gaitclip_host::cost::qemu;

@@ -2,7 +2,8 @@
 //! the fixture sample by sample and ends with the trace.
 
 use embedded_hal_mock::eh1::delay::NoopDelay;
-use gaitclip::mpu6050::{Address, Config, Error, Mpu6050, OutputRate};
+use gaitclip::mpu6050::blocking::Mpu6050;
+use gaitclip::mpu6050::{Address, Config, Error, OutputRate};
 use gaitclip::sensor::sample::RawSample;
 use gaitclip_board::replay_mpu6050;
 use replay_mpu6050::{ReplayBusError, ReplayMpu6050};
@@ -14,12 +15,12 @@ fn driver_reads_the_trace_through_the_emulated_bus() {
     )
     .unwrap()
     .leak();
-    let mut imu = Mpu6050::new(ReplayMpu6050::new(0x68, bytes, &[]), Address::Ad0Low);
-    imu.init(
-        &mut NoopDelay,
-        &Config::new(OutputRate::from_hz(200).unwrap()),
-    )
-    .unwrap();
+    let mut imu = Mpu6050::new(ReplayMpu6050::new(0x68, bytes, &[]), Address::Ad0Low)
+        .init(
+            &mut NoopDelay,
+            &Config::new(OutputRate::from_hz(200).unwrap()),
+        )
+        .unwrap();
     let mut n = 0;
     loop {
         match imu.read_sample() {

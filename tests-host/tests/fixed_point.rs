@@ -6,6 +6,7 @@ use gaitclip::detect::stance::{deflate, StanceThresholds, DEFLATED_IQR_MAX, DEFL
 use gaitclip::detect::zupt::ZuptIntegrator;
 use gaitclip::fixed::{isqrt_u64, mul_q30, QuatQ30, Q30_ONE};
 use gaitclip::sensor::rate::SampleRate;
+use gaitclip::sensor::sample::RangeScale;
 use gaitclip::sensor::sample::{AccelRange, GyroRange, RawSample};
 use gaitclip::signal::mean_filter::MeanFilter;
 use gaitclip_host::sim::fixtures::FIRMWARE_TRACE;
@@ -621,7 +622,7 @@ fn gyro_counts_of_mrad_per_s_within_half_a_count() {
             let exact = mrad as f64 / 1000.0 * 180.0 / std::f64::consts::PI
                 * gyro.lsb_per_dps_x10() as f64
                 / 10.0;
-            let got = gyro.counts_of_mrad_per_s(mrad) as f64;
+            let got = gyro.scale().counts_of_mrad_per_s(mrad) as f64;
             assert!(
                 (got - exact).abs() <= 0.5 + exact * 1e-6,
                 "{gyro:?} {mrad}: {got} vs {exact}"

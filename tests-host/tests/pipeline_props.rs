@@ -6,6 +6,7 @@ use gaitclip::pipeline::detectors::AnyDetector;
 use gaitclip::pipeline::Pipeline;
 use gaitclip::record::stride::{Stride, StrideFlags, MAX_STRIDE_MM};
 use gaitclip::sensor::rate::SampleRate;
+use gaitclip::sensor::sample::RangeScale;
 use gaitclip::sensor::sample::{AccelRange, GyroRange, RawSample};
 use proptest::prelude::*;
 

@@ -3,7 +3,8 @@
 //! driver on top), and the emulated part's wake-ups and motion test.
 
 use embedded_hal_mock::eh1::delay::NoopDelay;
-use gaitclip::mpu6050::{Address, Config, Mpu6050, OutputRate};
+use gaitclip::mpu6050::blocking::Mpu6050;
+use gaitclip::mpu6050::{Address, Config, OutputRate};
 use gaitclip::sensor::rate::SampleRate;
 use gaitclip::sensor::sample::RawSample;
 use gaitclip_board::imu_sampler::{ImuSampler, Item, ReadMode};
@@ -128,10 +129,10 @@ fn the_sampler_sleeps_wakes_on_motion_and_declares_what_it_did_not_sample() {
     // The cycle mode's wake-ups: every 40 periods (5 Hz at 200 Hz) on the sensor's clock,
     // at 40 and 80 still; the one at 120 is past the recording's 100 samples: it ended
     // asleep (the tilt at 90 fell between wake-ups).
-    assert_eq!(s.bus_mut().wake_tick(), WakeTick::Still); // period 40
-    assert_eq!(s.bus_mut().position(), 41);
-    assert_eq!(s.bus_mut().wake_tick(), WakeTick::Still); // period 80
-    assert_eq!(s.bus_mut().wake_tick(), WakeTick::Ended); // period 120: past the end
+    assert_eq!(s.bus_mut().unwrap().wake_tick(), WakeTick::Still); // period 40
+    assert_eq!(s.bus_mut().unwrap().position(), 41);
+    assert_eq!(s.bus_mut().unwrap().wake_tick(), WakeTick::Still); // period 80
+    assert_eq!(s.bus_mut().unwrap().wake_tick(), WakeTick::Ended); // period 120: past the end
 }
 
 #[test]
@@ -146,9 +147,9 @@ fn a_tilt_wakes_the_sensor_and_full_sampling_resumes_after_the_gyro_settles() {
     assert!(s.asleep());
     // Wake-ups at periods 40 and 80 see the still clip; at 120 the tilt (sample 120 against
     // sample 80: 1190 counts on x, over the 196 of 96 mg).
-    let ticks: Vec<WakeTick> = (0..3).map(|_| s.bus_mut().wake_tick()).collect();
+    let ticks: Vec<WakeTick> = (0..3).map(|_| s.bus_mut().unwrap().wake_tick()).collect();
     assert_eq!(ticks, [WakeTick::Still, WakeTick::Still, WakeTick::Motion]);
-    let slept = s.bus_mut().periods_in_cycle();
+    let slept = s.bus_mut().unwrap().periods_in_cycle();
     assert_eq!(slept, 111, "periods 10..=120 went unsampled");
     items.clear();
     s.on_motion(slept, 6, &mut push_into(&mut items));
@@ -169,7 +170,7 @@ fn a_tilt_wakes_the_sensor_and_full_sampling_resumes_after_the_gyro_settles() {
     assert_eq!((c.sleeps, c.slept_periods, c.lost_samples), (1, 117, 0));
     // The motion latch was read and cleared on the way back.
     assert_eq!(
-        s.bus_mut().wake_tick(),
+        s.bus_mut().unwrap().wake_tick(),
         WakeTick::Awake,
         "out of cycle mode, no wake-ups"
     );
@@ -326,7 +327,7 @@ fn sleep_and_wake_on_the_bus_transaction_by_transaction() {
     assert_eq!(items[2], Item::Woke(41));
     assert_eq!(accel_x(&items[3]), Some(3));
     assert_eq!(s.counters().bus_errors, 0);
-    s.bus_mut().0.done();
+    s.bus_mut().unwrap().0.done();
 }
 
 /// The policy's rules for each queue item: samples count towards the still period (a due

@@ -23,7 +23,9 @@
 use embedded_hal::delay::DelayNs;
 use embedded_hal::i2c::I2c;
 use gaitclip::detect::seam::StepDetector;
-use gaitclip::mpu6050::{self, MotionWake, Mpu6050};
+use gaitclip::mpu6050::blocking::Mpu6050;
+use gaitclip::mpu6050::mode::{MotionWake, Sampling, Unconfigured};
+use gaitclip::mpu6050::{self, MotionWakeConfig};
 use gaitclip::pipeline::Pipeline;
 use gaitclip::record::stride::Stride;
 use gaitclip::sensor::sample::RawSample;
@@ -124,9 +126,47 @@ impl Counters {
     };
 }
 
+/// The driver in the mode the sampler last brought it to (the driver's modes are types; the
+/// sampler switches between them at run time).
+enum Sensor<I> {
+    Sampling(Mpu6050<I, Sampling>),
+    Waiting(Mpu6050<I, MotionWake>),
+}
+
+impl<I: I2c> Sensor<I> {
+    fn bus_mut(&mut self) -> &mut I {
+        match self {
+            Sensor::Sampling(d) => d.bus_mut(),
+            Sensor::Waiting(d) => d.bus_mut(),
+        }
+    }
+
+    /// Resets the part into sampling from either mode ([`Mpu6050::init`]); on failure the
+    /// driver stays in the mode it was.
+    fn init<D: DelayNs>(
+        self,
+        delay: &mut D,
+        config: &mpu6050::Config,
+    ) -> (Self, Result<(), mpu6050::Error<I::Error>>) {
+        let r = match self {
+            Sensor::Sampling(d) => d
+                .init(delay, config)
+                .map_err(|e| (Sensor::Sampling(e.dev), e.error)),
+            Sensor::Waiting(d) => d
+                .init(delay, config)
+                .map_err(|e| (Sensor::Waiting(e.dev), e.error)),
+        };
+        match r {
+            Ok(d) => (Sensor::Sampling(d), Ok(())),
+            Err((s, e)) => (s, Err(e)),
+        }
+    }
+}
+
 /// The sensor, its settings and the fault bookkeeping.
 pub struct ImuSampler<I, D> {
-    imu: Mpu6050<I>,
+    /// Always `Some` between calls: taken only while a mode change moves the driver.
+    imu: Option<Sensor<I>>,
     delay: D,
     config: mpu6050::Config,
     mode: ReadMode,
@@ -141,9 +181,7 @@ pub struct ImuSampler<I, D> {
     /// settles (what [`ImuSampler::request_sleep`] counts).
     read: u32,
     /// Go to the low-power wait once this many samples have been read, with these settings.
-    sleep_request: Option<(u32, MotionWake)>,
-    /// In the low-power wait for motion.
-    asleep: bool,
+    sleep_request: Option<(u32, MotionWakeConfig)>,
     /// Samples still to drop after waking while the gyro settles.
     settling: u32,
     /// Periods unsampled since the sensor went to sleep, not yet handed over as
@@ -160,13 +198,20 @@ where
     /// and delay are handed back with it, for the board to report and retry.
     #[allow(clippy::type_complexity)]
     pub fn start(
-        imu: Mpu6050<I>,
-        delay: D,
+        imu: Mpu6050<I, Unconfigured>,
+        mut delay: D,
         config: mpu6050::Config,
         mode: ReadMode,
-    ) -> Result<Self, (Mpu6050<I>, D, mpu6050::Error<I::Error>)> {
-        let mut s = ImuSampler {
-            imu,
+    ) -> Result<Self, (Mpu6050<I, Unconfigured>, D, mpu6050::Error<I::Error>)> {
+        let mut imu = match imu.init(&mut delay, &config) {
+            Ok(imu) => imu,
+            Err(e) => return Err((e.dev, delay, e.error)),
+        };
+        if let Err(e) = enable_interrupt(&mut imu, mode) {
+            return Err((imu.into_unconfigured(), delay, e));
+        }
+        Ok(ImuSampler {
+            imu: Some(Sensor::Sampling(imu)),
             delay,
             config,
             mode,
@@ -176,14 +221,9 @@ where
             counters: Counters::default(),
             read: 0,
             sleep_request: None,
-            asleep: false,
             settling: 0,
             pending_woke: 0,
-        };
-        match s.setup() {
-            Ok(()) => Ok(s),
-            Err(e) => Err((s.imu, s.delay, e)),
-        }
+        })
     }
 
     /// The fault counters.
@@ -234,7 +274,7 @@ where
     /// is due ([`ImuSampler::request_sleep`]), sends the sensor to its wait for motion.
     /// Ignored while asleep (the board calls [`ImuSampler::on_motion`] for the INT pin then).
     pub fn on_data_ready(&mut self, push: &mut impl FnMut(Item) -> bool) {
-        if self.asleep {
+        if self.asleep() {
             return;
         }
         match self.mode {
@@ -262,7 +302,7 @@ where
 
     /// Whether the sensor is in its low-power wait for motion.
     pub const fn asleep(&self) -> bool {
-        self.asleep
+        matches!(self.imu, Some(Sensor::Waiting(_)))
     }
 
     /// Sends the sensor to its low-power wait for motion ([`Mpu6050::enter_motion_wake`])
@@ -271,15 +311,30 @@ where
     /// it asks for a count ahead of anything the queue can hold, so the sleep falls after
     /// the same sample however far behind it ran (the replay's host model relies on it).
     /// Replaces an earlier request.
-    pub fn request_sleep(&mut self, after: u32, wake: MotionWake) {
+    pub fn request_sleep(&mut self, after: u32, wake: MotionWakeConfig) {
         self.sleep_request = Some((after, wake));
     }
 
-    fn enter_sleep(&mut self, wake: &MotionWake, push: &mut impl FnMut(Item) -> bool) {
+    fn enter_sleep(&mut self, wake: &MotionWakeConfig, push: &mut impl FnMut(Item) -> bool) {
         for _ in 0..=RETRIES {
-            match self.imu.enter_motion_wake(wake, self.config.accel) {
-                Ok(()) => {
-                    self.asleep = true;
+            let entered = match self.imu.take() {
+                Some(Sensor::Sampling(d)) => match d.enter_motion_wake(wake, self.config.accel) {
+                    Ok(d) => {
+                        self.imu = Some(Sensor::Waiting(d));
+                        true
+                    }
+                    Err(e) => {
+                        self.imu = Some(Sensor::Sampling(e.dev));
+                        false
+                    }
+                },
+                other => {
+                    self.imu = other;
+                    false
+                }
+            };
+            match entered {
+                true => {
                     self.unread = 0;
                     self.counters.sleeps = self.counters.sleeps.saturating_add(1);
                     if !push(Item::Asleep) {
@@ -287,7 +342,7 @@ where
                     }
                     return;
                 }
-                Err(_) => self.counters.bus_errors = self.counters.bus_errors.saturating_add(1),
+                false => self.counters.bus_errors = self.counters.bus_errors.saturating_add(1),
             }
         }
         // Half configured: set the sensor up again and stay awake; the main loop asks
@@ -301,16 +356,15 @@ where
     /// passed while asleep (the board's low-power clock). Both become one [`Item::Woke`]
     /// before the first sample kept. On a bus error the sensor is set up again from reset.
     pub fn on_motion(&mut self, slept: u32, settle: u32, push: &mut impl FnMut(Item) -> bool) {
-        if !self.asleep {
+        if !self.asleep() {
             return;
         }
-        self.asleep = false;
         self.settling = settle;
         self.pending_woke = self.pending_woke.saturating_add(slept);
         self.counters.slept_periods = self.counters.slept_periods.saturating_add(slept);
         let mut resumed = false;
         for _ in 0..=RETRIES {
-            if self.resume().is_ok() {
+            if self.resume() {
                 resumed = true;
                 break;
             }
@@ -324,8 +378,19 @@ where
         }
     }
 
-    fn resume(&mut self) -> Result<(), mpu6050::Error<I::Error>> {
-        self.imu.leave_motion_wake(&self.config)?;
+    /// Leaves the motion wait (if still in it: a retry after the interrupt's setup failed
+    /// is already sampling) and sets the interrupt up again.
+    fn resume(&mut self) -> bool {
+        match self.imu.take() {
+            Some(Sensor::Waiting(d)) => match d.leave_motion_wake(&self.config) {
+                Ok(d) => self.imu = Some(Sensor::Sampling(d)),
+                Err(e) => {
+                    self.imu = Some(Sensor::Waiting(e.dev));
+                    return false;
+                }
+            },
+            other => self.imu = other,
+        }
         self.enable_interrupt()
     }
 
@@ -341,15 +406,16 @@ where
         true
     }
 
-    /// The bus, for a board's emulated sensor (its clock in the low-power wait) and tests.
-    pub fn bus_mut(&mut self) -> &mut I {
-        self.imu.bus_mut()
+    /// The bus, for a board's emulated sensor (its clock in the low-power wait) and tests;
+    /// `None` only inside a mode change, which no caller can see.
+    pub fn bus_mut(&mut self) -> Option<&mut I> {
+        self.imu.as_mut().map(Sensor::bus_mut)
     }
 
     /// The board's watchdog found no data-ready pulse for `periods` sample periods: the
     /// sensor was reset or lost power. They become a gap and the sensor is set up again.
     pub fn on_silence(&mut self, periods: u32, push: &mut impl FnMut(Item) -> bool) {
-        if self.asleep {
+        if self.asleep() {
             // Silent by design: the sensor only speaks again on motion.
             return;
         }
@@ -364,15 +430,20 @@ where
 
     fn read_one(&mut self, push: &mut impl FnMut(Item) -> bool) {
         for _ in 0..=RETRIES {
-            match self.imu.read_sample() {
-                Ok(s) => {
+            let read = match &mut self.imu {
+                Some(Sensor::Sampling(d)) => d.read_sample().ok(),
+                // Never here while awake; a read that cannot happen fails like a bus error.
+                _ => None,
+            };
+            match read {
+                Some(s) => {
                     self.failed_periods = 0;
                     if self.keep() {
                         self.emit(push, Item::Sample(s));
                     }
                     return;
                 }
-                Err(_) => self.counters.bus_errors = self.counters.bus_errors.saturating_add(1),
+                None => self.counters.bus_errors = self.counters.bus_errors.saturating_add(1),
             }
         }
         // The sample of this period is gone (the registers hold only the newest).
@@ -386,7 +457,11 @@ where
         // More than one burst when the reads fell behind; bounded by what was pulsed.
         let mut bursts = self.unread as usize / FIFO_BURST + 1;
         while bursts > 0 {
-            match self.imu.read_fifo(&mut buf) {
+            let read = match &mut self.imu {
+                Some(Sensor::Sampling(d)) => d.read_fifo(&mut buf).map_err(Some),
+                _ => Err(None),
+            };
+            match read {
                 Ok(n) => {
                     self.failed_periods = 0;
                     self.unread = self.unread.saturating_sub(n as u32);
@@ -402,7 +477,7 @@ where
                     }
                     bursts -= 1;
                 }
-                Err(mpu6050::Error::FifoOverflow) | Err(mpu6050::Error::FifoMisaligned(_)) => {
+                Err(Some(mpu6050::Error::FifoOverflow | mpu6050::Error::FifoMisaligned(_))) => {
                     // The FIFO was reset: everything pulsed since the last read is gone.
                     self.counters.fifo_overflows = self.counters.fifo_overflows.saturating_add(1);
                     let lost = core::mem::take(&mut self.unread);
@@ -435,32 +510,47 @@ where
     /// Recovers the bus and sets the sensor up again; on failure the next failed period
     /// tries again.
     fn restart(&mut self) {
-        if self.imu.bus_mut().recover_bus() {
+        if self.imu.as_mut().is_some_and(|s| s.bus_mut().recover_bus()) {
             self.counters.recoveries = self.counters.recoveries.saturating_add(1);
         }
-        match self.setup() {
-            Ok(()) => {
-                self.counters.restarts = self.counters.restarts.saturating_add(1);
-                self.failed_periods = 0;
-            }
-            Err(_) => self.counters.bus_errors = self.counters.bus_errors.saturating_add(1),
+        if self.setup() {
+            self.counters.restarts = self.counters.restarts.saturating_add(1);
+            self.failed_periods = 0;
+        } else {
+            self.counters.bus_errors = self.counters.bus_errors.saturating_add(1);
         }
     }
 
-    fn setup(&mut self) -> Result<(), mpu6050::Error<I::Error>> {
-        self.imu.init(&mut self.delay, &self.config)?;
-        // A reset sensor is awake whatever it was doing.
-        self.asleep = false;
-        self.enable_interrupt()
+    /// Resets the sensor into sampling (a reset sensor is awake whatever it was doing) and
+    /// sets its interrupt up; whether both worked.
+    fn setup(&mut self) -> bool {
+        let Some(sensor) = self.imu.take() else {
+            return false;
+        };
+        let (sensor, reset) = sensor.init(&mut self.delay, &self.config);
+        self.imu = Some(sensor);
+        reset.is_ok() && self.enable_interrupt()
     }
 
-    fn enable_interrupt(&mut self) -> Result<(), mpu6050::Error<I::Error>> {
-        match self.mode {
-            ReadMode::PerSample => self.imu.enable_data_ready_interrupt(),
-            ReadMode::Fifo { .. } => {
-                self.imu.enable_fifo()?;
-                self.imu.enable_data_ready_pulse()
-            }
+    /// Sets the data-ready interrupt up for the read mode; false if that failed (or the
+    /// sensor is not sampling).
+    fn enable_interrupt(&mut self) -> bool {
+        match &mut self.imu {
+            Some(Sensor::Sampling(d)) => enable_interrupt(d, self.mode).is_ok(),
+            _ => false,
+        }
+    }
+}
+
+fn enable_interrupt<I: I2c>(
+    d: &mut Mpu6050<I, Sampling>,
+    mode: ReadMode,
+) -> Result<(), mpu6050::Error<I::Error>> {
+    match mode {
+        ReadMode::PerSample => d.enable_data_ready_interrupt(),
+        ReadMode::Fifo { .. } => {
+            d.enable_fifo()?;
+            d.enable_data_ready_pulse()
         }
     }
 }

@@ -15,7 +15,9 @@ use embedded_hal::delay::DelayNs;
 use embedded_hal::digital::OutputPin;
 use embedded_hal::i2c::I2c;
 use gaitclip::detect::seam::StepDetector;
-use gaitclip::mpu6050::{self, Mpu6050};
+use gaitclip::mpu6050;
+use gaitclip::mpu6050::blocking::Mpu6050;
+use gaitclip::mpu6050::mode::Unconfigured;
 use gaitclip::pipeline::config::Config;
 use gaitclip::pipeline::Pipeline;
 use gaitclip::record::stride::Stride;
@@ -73,7 +75,7 @@ where
     /// the interrupts, and returns the queue's consumer for the main loop.
     pub fn start<const N: usize>(
         &self,
-        imu: Mpu6050<I>,
+        imu: Mpu6050<I, Unconfigured>,
         delay: D,
         config: mpu6050::Config,
         mode: ReadMode,
@@ -207,7 +209,7 @@ where
     }
 
     /// Asks the sampler to sleep after `after` samples in all ([`ImuSampler::request_sleep`]).
-    pub fn request_sleep(&self, after: u32, wake: gaitclip::mpu6050::MotionWake) {
+    pub fn request_sleep(&self, after: u32, wake: gaitclip::mpu6050::MotionWakeConfig) {
         self.with_sampler(|s, _| s.request_sleep(after, wake));
     }
 }
@@ -322,7 +324,7 @@ impl Drain {
 /// Starts the sensor, retrying once a second (and saying so on both outputs) while it does
 /// not answer: still powering up, or a loose wire.
 pub fn start_sensor<I, D>(
-    mut imu: Mpu6050<I>,
+    mut imu: Mpu6050<I, Unconfigured>,
     mut delay: D,
     config: mpu6050::Config,
     mode: ReadMode,

@@ -6,6 +6,7 @@ use gaitclip::mpu6050;
 use gaitclip::pipeline::config::Config;
 use gaitclip::sensor::rate::SampleRate;
 use gaitclip::sensor::sample::{AccelRange, GyroRange};
+use gaitclip::sensor::units::{AccelScale, GyroScale};
 
 /// Output data rate of the sensor, Hz.
 pub const RATE_HZ: u16 = 200;
@@ -29,7 +30,7 @@ pub const CONFIG: Config = config(RATE, ACCEL, GYRO);
 /// The pipeline's configuration for samples at `rate` in the given ranges, with the
 /// firmware's [`crate::DETECTOR`].
 pub const fn config(rate: SampleRate, accel: AccelRange, gyro: GyroRange) -> Config {
-    let mut c = Config::new(rate, accel.scale(), gyro.scale());
+    let mut c = Config::new(rate, AccelScale::of(accel), GyroScale::of(gyro));
     c.detector = crate::DETECTOR;
     c
 }

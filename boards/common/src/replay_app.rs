@@ -15,11 +15,13 @@
 //! `replay-sleep` feature the sensor holds still for the runs of [`STILL`].
 
 use core::sync::atomic::{AtomicBool, Ordering};
+use gaitclip::sensor::sample::RangeScale;
 
 use cortex_m::interrupt as irq;
 use cortex_m_semihosting::debug::{self, EXIT_FAILURE, EXIT_SUCCESS};
 use gaitclip::detect::seam::StepDetector;
-use gaitclip::mpu6050::{self, Address, Mpu6050};
+use gaitclip::mpu6050::blocking::Mpu6050;
+use gaitclip::mpu6050::{self, Address};
 use gaitclip::pipeline::config::Config;
 use gaitclip::pipeline::Pipeline;
 use gaitclip::sensor::rate::SampleRate;
@@ -271,10 +273,14 @@ enum Tick {
 fn on_timer_interrupt(timer: &impl SampleTimer) {
     timer.clear_interrupt();
     let tick = LINK.with_sampler(|s, mut push| {
-        if s.asleep() {
-            return match s.bus_mut().wake_tick() {
+        let asleep = s.asleep();
+        let Some(sensor) = s.bus_mut() else {
+            return Tick::Done; // not reached: the sampler always holds its sensor
+        };
+        if asleep {
+            return match sensor.wake_tick() {
                 WakeTick::Motion => {
-                    let slept = s.bus_mut().periods_in_cycle();
+                    let slept = sensor.periods_in_cycle();
                     s.on_motion(slept, SETTLE, &mut push);
                     Tick::Woke
                 }
@@ -282,7 +288,7 @@ fn on_timer_interrupt(timer: &impl SampleTimer) {
                 WakeTick::Still | WakeTick::Awake => Tick::Same,
             };
         }
-        if s.bus_mut().remaining() == 0 {
+        if sensor.remaining() == 0 {
             return Tick::Done;
         }
         s.on_data_ready(&mut push);

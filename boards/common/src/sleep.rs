@@ -9,7 +9,7 @@
 //! 1. the main loop asks the sampler to sleep ahead of anything still queued
 //!    ([`crate::imu_sampler::ImuSampler::request_sleep`], [`SleepPolicy::sleep_after`]),
 //!    and the sampler puts the sensor in its cycle mode with the motion interrupt latched on
-//!    INT ([`gaitclip::mpu6050::Mpu6050::enter_motion_wake`]) and queues
+//!    INT ([`gaitclip::mpu6050::blocking::Mpu6050::enter_motion_wake`]) and queues
 //!    [`crate::imu_sampler::Item::Asleep`];
 //! 2. the board stops its sample-side timers (the sensor watchdog: a sleeping sensor is
 //!    silent by design), says so on its outputs, and the core waits for INT (System ON,
@@ -25,7 +25,7 @@
 //! Everything here is plain state, so the host tests (`tests-host/tests/sleep_policy.rs`)
 //! and the host model of the sleeping replay firmware use this very code.
 
-use gaitclip::mpu6050::{MotionThreshold, MotionThresholdUnit, MotionWake, WakeRate};
+use gaitclip::mpu6050::{MotionThreshold, MotionThresholdUnit, MotionWakeConfig, WakeRate};
 use gaitclip::sensor::rate::SampleRate;
 
 use crate::imu_sampler::Item;
@@ -36,7 +36,7 @@ pub struct SleepSettings {
     /// Still this long (rest test true, no stride) before sleeping, ms.
     pub still_ms: u32,
     /// The sensor's wait for motion.
-    pub wake: MotionWake,
+    pub wake: MotionWakeConfig,
     /// Samples dropped after waking while the gyro starts, ms (datasheet §6.1, gyroscope
     /// start-up time: 30 ms typical).
     pub settle_ms: u32,
@@ -67,7 +67,7 @@ const fn threshold(mg: u32) -> MotionThreshold {
 /// of [`WAKE_THRESHOLD_MG`] for 1 ms, and 30 ms of gyro settling.
 pub const SLEEP: SleepSettings = SleepSettings {
     still_ms: 10_000,
-    wake: MotionWake {
+    wake: MotionWakeConfig {
         rate: WakeRate::Hz5,
         threshold: threshold(WAKE_THRESHOLD_MG),
         duration_ms: 1,

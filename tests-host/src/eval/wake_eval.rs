@@ -15,6 +15,7 @@
 //! * **slept through**: no wake-up within [`MISSED_S`] of the movement's start: a walk whose
 //!   first stride would be lost entirely.
 
+use gaitclip::sensor::sample::RangeScale;
 use std::fmt::Write as _;
 use std::path::Path;
 

@@ -19,6 +19,7 @@ use gaitclip::detect::{rest, stance};
 use gaitclip::pipeline::config::Config;
 use gaitclip::pipeline::MEAN_FILTER_MS;
 use gaitclip::sensor::rate::SampleRate;
+use gaitclip::sensor::sample::RangeScale;
 use gaitclip::sensor::sample::RawSample;
 use nalgebra::{Matrix3, SymmetricEigen, Vector3};
 

@@ -1,58 +1,49 @@
-//! MPU6050 driver against a mocked bus. Every expected transaction is spelled out, and the
-//! register addresses are written here from the register map, not imported from the driver.
+//! The blocking driver against a mocked bus. Every expected transaction is spelled out, and
+//! the register addresses are written here from the register map, not imported from the
+//! driver. `tests/asynch.rs` runs the async driver against the same transactions.
 
 use embedded_hal::i2c::ErrorKind;
 use embedded_hal_mock::eh1::delay::NoopDelay;
 use embedded_hal_mock::eh1::i2c::{Mock, Transaction as T};
-use gaitclip::mpu6050::{
-    Address, Config, Error, MotionThreshold, MotionThresholdUnit, MotionWake, Mpu6050, OutputRate,
-    WakeRate,
+use gaitclip_mpu6050::blocking::Mpu6050;
+use gaitclip_mpu6050::mode::{MotionWake, Sampling};
+mod bus;
+use bus::*;
+
+use gaitclip_mpu6050::{
+    AccelRange, Address, Config, Error, GyroRange, MotionThreshold, MotionThresholdUnit,
+    MotionWakeConfig, OutputRate, RawSample, WakeRate,
 };
-use gaitclip::sensor::sample::{AccelRange, GyroRange, RawSample};
 
-const ADDR: u8 = 0x68;
-const SMPLRT_DIV: u8 = 0x19;
-const CONFIG: u8 = 0x1A;
-const GYRO_CONFIG: u8 = 0x1B;
-const ACCEL_CONFIG: u8 = 0x1C;
-const FIFO_EN: u8 = 0x23;
-const INT_PIN_CFG: u8 = 0x37;
-const INT_ENABLE: u8 = 0x38;
-const INT_STATUS: u8 = 0x3A;
-const ACCEL_XOUT_H: u8 = 0x3B;
-const USER_CTRL: u8 = 0x6A;
-const PWR_MGMT_1: u8 = 0x6B;
-const FIFO_COUNT_H: u8 = 0x72;
-const FIFO_R_W: u8 = 0x74;
-const WHO_AM_I: u8 = 0x75;
-
-fn init_transactions(addr: u8, div: u8, dlpf: u8, fs: u8, afs: u8) -> Vec<T> {
-    vec![
-        T::write_read(addr, vec![WHO_AM_I], vec![0x68]),
-        T::write(addr, vec![PWR_MGMT_1, 0x80]),
-        T::write(addr, vec![PWR_MGMT_1, 0x01]),
-        T::write(addr, vec![SMPLRT_DIV, div]),
-        T::write(addr, vec![CONFIG, dlpf]),
-        T::write(addr, vec![GYRO_CONFIG, fs << 3]),
-        T::write(addr, vec![ACCEL_CONFIG, afs << 3]),
-    ]
+/// A driver brought to sampling by `init` at 200 Hz (its transactions first), then `rest`.
+fn sampling(rest: &[T]) -> (Mock, Mpu6050<Mock, Sampling>) {
+    let mut all = init_transactions(ADDR, 4, 2, 3, 3);
+    all.extend_from_slice(rest);
+    let bus = Mock::new(&all);
+    let imu = Mpu6050::new(bus.clone(), Address::Ad0Low)
+        .init(
+            &mut NoopDelay,
+            &Config::new(OutputRate::from_hz(200).unwrap()),
+        )
+        .unwrap();
+    (bus, imu)
 }
 
 #[test]
 fn init_200hz_defaults_to_16g_2000dps() {
     let mut bus = Mock::new(&init_transactions(ADDR, 4, 2, 3, 3));
-    let mut imu = Mpu6050::new(bus.clone(), Address::Ad0Low);
+    let imu = Mpu6050::new(bus.clone(), Address::Ad0Low);
     let config = Config::new(OutputRate::from_hz(200).unwrap());
     assert_eq!(config.accel, AccelRange::G16);
     assert_eq!(config.gyro, GyroRange::Dps2000);
-    imu.init(&mut NoopDelay, &config).unwrap();
+    let _sampling: Mpu6050<_, Sampling> = imu.init(&mut NoopDelay, &config).unwrap();
     bus.done();
 }
 
 #[test]
 fn init_at_ad0_high_with_other_ranges_and_1khz() {
     let mut bus = Mock::new(&init_transactions(0x69, 0, 1, 1, 2));
-    let mut imu = Mpu6050::new(bus.clone(), Address::Ad0High);
+    let imu = Mpu6050::new(bus.clone(), Address::Ad0High);
     let config = Config {
         rate: OutputRate::from_hz(1000).unwrap(),
         accel: AccelRange::G8,
@@ -109,14 +100,16 @@ fn lsb_constants_per_range() {
 #[test]
 fn wrong_device_is_reported_and_nothing_is_written() {
     let mut bus = Mock::new(&[T::write_read(ADDR, vec![WHO_AM_I], vec![0x70])]);
-    let mut imu = Mpu6050::new(bus.clone(), Address::Ad0Low);
+    let imu = Mpu6050::new(bus.clone(), Address::Ad0Low);
     let e = imu
         .init(
             &mut NoopDelay,
             &Config::new(OutputRate::from_hz(200).unwrap()),
         )
         .unwrap_err();
-    assert_eq!(e, Error::WrongDevice(0x70));
+    assert_eq!(e.error, Error::WrongDevice(0x70));
+    // The driver comes back, still unconfigured, with its bus.
+    let _bus = e.dev.release();
     bus.done();
 }
 
@@ -140,8 +133,7 @@ fn burst_read_decodes_big_endian_accel_temp_gyro() {
         0x80, 0x00, // gy = −32768
         0x12, 0x34, // gz = 0x1234
     ];
-    let mut bus = Mock::new(&[T::write_read(ADDR, vec![ACCEL_XOUT_H], regs.clone())]);
-    let mut imu = Mpu6050::new(bus.clone(), Address::Ad0Low);
+    let (mut bus, mut imu) = sampling(&[T::write_read(ADDR, vec![ACCEL_XOUT_H], regs.clone())]);
     let s = imu.read_sample().unwrap();
     assert_eq!(
         s,
@@ -158,12 +150,11 @@ fn burst_read_decodes_big_endian_accel_temp_gyro() {
 
 #[test]
 fn data_ready_interrupt_enable_and_clear() {
-    let mut bus = Mock::new(&[
+    let (mut bus, mut imu) = sampling(&[
         T::write(ADDR, vec![INT_PIN_CFG, 0x30]),
         T::write(ADDR, vec![INT_ENABLE, 0x11]),
         T::write_read(ADDR, vec![INT_STATUS], vec![0x01]),
     ]);
-    let mut imu = Mpu6050::new(bus.clone(), Address::Ad0Low);
     imu.enable_data_ready_interrupt().unwrap();
     let st = imu.read_interrupt_status().unwrap();
     assert!(st.data_ready() && !st.fifo_overflow());
@@ -174,7 +165,7 @@ fn data_ready_interrupt_enable_and_clear() {
 fn fifo_enable_count_and_burst_read() {
     let one = vec![0, 1, 0, 2, 0, 3, 0, 4, 0, 5, 0, 6, 0, 7];
     let two: Vec<u8> = one.iter().map(|b| b * 2).collect();
-    let mut bus = Mock::new(&[
+    let (mut bus, mut imu) = sampling(&[
         T::write(ADDR, vec![USER_CTRL, 0x04]),
         T::write(ADDR, vec![FIFO_EN, 0xF8]),
         T::write(ADDR, vec![USER_CTRL, 0x40]),
@@ -183,7 +174,6 @@ fn fifo_enable_count_and_burst_read() {
         T::write_read(ADDR, vec![FIFO_R_W], one),
         T::write_read(ADDR, vec![FIFO_R_W], two),
     ]);
-    let mut imu = Mpu6050::new(bus.clone(), Address::Ad0Low);
     imu.enable_fifo().unwrap();
     let mut out = [RawSample::default(); 4];
     assert_eq!(imu.read_fifo(&mut out).unwrap(), 2);
@@ -195,11 +185,10 @@ fn fifo_enable_count_and_burst_read() {
 
 #[test]
 fn fifo_overflow_resets_and_reports() {
-    let mut bus = Mock::new(&[
+    let (mut bus, mut imu) = sampling(&[
         T::write_read(ADDR, vec![INT_STATUS], vec![0x10]),
         T::write(ADDR, vec![USER_CTRL, 0x44]),
     ]);
-    let mut imu = Mpu6050::new(bus.clone(), Address::Ad0Low);
     let mut out = [RawSample::default(); 4];
     assert_eq!(imu.read_fifo(&mut out).unwrap_err(), Error::FifoOverflow);
     bus.done();
@@ -207,12 +196,11 @@ fn fifo_overflow_resets_and_reports() {
 
 #[test]
 fn fifo_partial_sample_is_misaligned() {
-    let mut bus = Mock::new(&[
+    let (mut bus, mut imu) = sampling(&[
         T::write_read(ADDR, vec![INT_STATUS], vec![0x00]),
         T::write_read(ADDR, vec![FIFO_COUNT_H], vec![0x00, 15]),
         T::write(ADDR, vec![USER_CTRL, 0x44]),
     ]);
-    let mut imu = Mpu6050::new(bus.clone(), Address::Ad0Low);
     let mut out = [RawSample::default(); 4];
     assert_eq!(
         imu.read_fifo(&mut out).unwrap_err(),
@@ -223,20 +211,15 @@ fn fifo_partial_sample_is_misaligned() {
 
 #[test]
 fn bus_error_during_read_surfaces_as_bus() {
-    let mut bus = Mock::new(&[
+    let (mut bus, mut imu) = sampling(&[
         T::write_read(ADDR, vec![ACCEL_XOUT_H], vec![0; 14]).with_error(ErrorKind::Other)
     ]);
-    let mut imu = Mpu6050::new(bus.clone(), Address::Ad0Low);
     assert_eq!(imu.read_sample().unwrap_err(), Error::Bus(ErrorKind::Other));
     bus.done();
 }
 
-const MOT_THR: u8 = 0x1F;
-const MOT_DUR: u8 = 0x20;
-const PWR_MGMT_2: u8 = 0x6C;
-
-fn motion_wake(mg: u32, unit: MotionThresholdUnit) -> MotionWake {
-    MotionWake {
+fn motion_wake(mg: u32, unit: MotionThresholdUnit) -> MotionWakeConfig {
+    MotionWakeConfig {
         rate: WakeRate::Hz5,
         threshold: MotionThreshold::from_mg(mg, unit).unwrap(),
         duration_ms: 2,
@@ -252,7 +235,7 @@ fn motion_wake(mg: u32, unit: MotionThresholdUnit) -> MotionWake {
 fn enter_motion_wake_transactions() {
     let wake = motion_wake(64, MotionThresholdUnit::Mg32);
     assert_eq!(wake.threshold.counts(), 2);
-    let mut bus = Mock::new(&[
+    let (mut bus, imu) = sampling(&[
         T::write(ADDR, vec![INT_ENABLE, 0x00]),
         T::write(ADDR, vec![USER_CTRL, 0x00]),
         T::write(ADDR, vec![FIFO_EN, 0x00]),
@@ -265,8 +248,7 @@ fn enter_motion_wake_transactions() {
         T::write(ADDR, vec![PWR_MGMT_2, 0x40 | 0x07]),
         T::write(ADDR, vec![PWR_MGMT_1, 0x20 | 0x08]),
     ]);
-    let mut imu = Mpu6050::new(bus.clone(), Address::Ad0Low);
-    imu.enter_motion_wake(&wake, AccelRange::G16).unwrap();
+    let _waiting: Mpu6050<_, MotionWake> = imu.enter_motion_wake(&wake, AccelRange::G16).unwrap();
     bus.done();
 }
 
@@ -275,19 +257,20 @@ fn enter_motion_wake_transactions() {
 fn motion_threshold_is_read_back() {
     let wake = motion_wake(100, MotionThresholdUnit::Mg2);
     assert_eq!(wake.threshold.counts(), 50);
-    let mut bus = Mock::new(&[
+    let (mut bus, imu) = sampling(&[
         T::write(ADDR, vec![INT_ENABLE, 0x00]),
         T::write(ADDR, vec![USER_CTRL, 0x00]),
         T::write(ADDR, vec![FIFO_EN, 0x00]),
         T::write(ADDR, vec![ACCEL_CONFIG, 0x10 | 0x01]),
         T::write(ADDR, vec![MOT_THR, 50]),
         T::write_read(ADDR, vec![MOT_THR], vec![0]),
+        // The driver came back still sampling: it reads on.
+        T::write_read(ADDR, vec![ACCEL_XOUT_H], vec![0; 14]),
     ]);
-    let mut imu = Mpu6050::new(bus.clone(), Address::Ad0Low);
-    assert_eq!(
-        imu.enter_motion_wake(&wake, AccelRange::G8),
-        Err(Error::Verify(MOT_THR, 50, 0))
-    );
+    let e = imu.enter_motion_wake(&wake, AccelRange::G8).unwrap_err();
+    assert_eq!(e.error, Error::Verify(MOT_THR, 50, 0));
+    let mut imu: Mpu6050<_, Sampling> = e.dev;
+    assert_eq!(imu.read_sample().unwrap(), RawSample::default());
     bus.done();
 }
 
@@ -295,15 +278,19 @@ fn motion_threshold_is_read_back() {
 /// standby, the high-pass filter off, the motion interrupt off and its latch read clear.
 #[test]
 fn leave_motion_wake_transactions() {
-    let mut bus = Mock::new(&[
+    let wake = motion_wake(64, MotionThresholdUnit::Mg32);
+    let mut script = enter_transactions(2, 0x18);
+    script.extend([
         T::write(ADDR, vec![PWR_MGMT_1, 0x01]),
         T::write(ADDR, vec![PWR_MGMT_2, 0x00]),
         T::write(ADDR, vec![ACCEL_CONFIG, 0x18]),
         T::write(ADDR, vec![INT_ENABLE, 0x00]),
         T::write_read(ADDR, vec![INT_STATUS], vec![0x40]),
     ]);
-    let mut imu = Mpu6050::new(bus.clone(), Address::Ad0Low);
-    imu.leave_motion_wake(&Config::new(OutputRate::from_hz(200).unwrap()))
+    let (mut bus, imu) = sampling(&script);
+    let waiting = imu.enter_motion_wake(&wake, AccelRange::G16).unwrap();
+    let _sampling: Mpu6050<_, Sampling> = waiting
+        .leave_motion_wake(&Config::new(OutputRate::from_hz(200).unwrap()))
         .unwrap();
     bus.done();
 }
@@ -335,4 +322,22 @@ fn wake_rates_and_thresholds() {
     // The same count is 16 times more acceleration in the other unit.
     let t = MotionThreshold::from_mg(96, Mg32).unwrap();
     assert_eq!((t.counts(), t.mg(Mg32), t.mg(Mg2)), (3, 96, 6));
+}
+
+/// `init` works from any mode: a part found in its motion wait (after a brown-out of the MCU,
+/// say) is reset into sampling.
+#[test]
+fn init_from_the_motion_wait_resets_into_sampling() {
+    let wake = motion_wake(64, MotionThresholdUnit::Mg32);
+    let mut script = enter_transactions(2, 0x18);
+    script.extend(init_transactions(ADDR, 4, 2, 3, 3));
+    let (mut bus, imu) = sampling(&script);
+    let waiting = imu.enter_motion_wake(&wake, AccelRange::G16).unwrap();
+    let _sampling = waiting
+        .init(
+            &mut NoopDelay,
+            &Config::new(OutputRate::from_hz(200).unwrap()),
+        )
+        .unwrap();
+    bus.done();
 }
