@@ -191,18 +191,7 @@ async fn run_async(opts: PodOptions) -> Result<()> {
                 .with_context(|| format!("no HCI controller at tcp:{addr}"))?;
             stream.set_nodelay(true)?;
             let (r, w) = stream.into_split();
-            let transport = bt_hci_serial::SerialTransport::<NoopRawMutex, _, _>::new(
-                FromTokio::new(r),
-                FromTokio::new(w),
-            );
-            let controller = ExternalController::<_, CONTROLLER_SLOTS>::new(transport);
-            serve(
-                rsc_gatt::run(controller, address, &LINK, &printer),
-                &prepared,
-                config,
-                &opts,
-            )
-            .await
+            serve_h4(r, w, address, &printer, &prepared, config, &opts).await
         }
         Hci::Serial { path, baud } => {
             use tokio_serial::SerialPortBuilderExt;
@@ -211,20 +200,37 @@ async fn run_async(opts: PodOptions) -> Result<()> {
                 .open_native_async()
                 .with_context(|| format!("cannot open serial:{path}@{baud}"))?;
             let (r, w) = tokio::io::split(port);
-            let transport = bt_hci_serial::SerialTransport::<NoopRawMutex, _, _>::new(
-                FromTokio::new(r),
-                FromTokio::new(w),
-            );
-            let controller = ExternalController::<_, CONTROLLER_SLOTS>::new(transport);
-            serve(
-                rsc_gatt::run(controller, address, &LINK, &printer),
-                &prepared,
-                config,
-                &opts,
-            )
-            .await
+            serve_h4(r, w, address, &printer, &prepared, config, &opts).await
         }
     }
+}
+
+/// The foot pod over one H4 byte stream, whatever carries its two halves (TCP or a UART).
+async fn serve_h4<R, W>(
+    r: R,
+    w: W,
+    address: Address,
+    printer: &Printer,
+    prepared: &Prepared,
+    config: Config,
+    opts: &PodOptions,
+) -> Result<()>
+where
+    R: tokio::io::AsyncRead + Unpin,
+    W: tokio::io::AsyncWrite + Unpin,
+{
+    let transport = bt_hci_serial::SerialTransport::<NoopRawMutex, _, _>::new(
+        FromTokio::new(r),
+        FromTokio::new(w),
+    );
+    let controller = ExternalController::<_, CONTROLLER_SLOTS>::new(transport);
+    serve(
+        rsc_gatt::run(controller, address, &LINK, printer),
+        prepared,
+        config,
+        opts,
+    )
+    .await
 }
 
 /// The Bluetooth side, the replay and SIGINT, together.
