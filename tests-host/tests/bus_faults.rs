@@ -4,6 +4,10 @@
 //! recovers the bus and re-initialises the sensor, reports the lost periods as a gap, and the
 //! pipeline reports the stride across the outage as invalid (a gap stride) and resumes: the
 //! strides before it are unchanged, the ones after it all found. No panic anywhere.
+//!
+//! Every scenario runs through both samplers, the blocking one of the bare-metal boards and
+//! the async one of the embassy board (`imu_sampler::asynch`), over the same script: the
+//! same transactions, items and counters.
 
 use embedded_hal::i2c::{ErrorKind, ErrorType, I2c, NoAcknowledgeSource, Operation};
 use embedded_hal_mock::eh1::delay::NoopDelay;
@@ -15,7 +19,7 @@ use gaitclip::record::stride::{Stride, StrideFlags};
 use gaitclip::sensor::rate::SampleRate;
 use gaitclip::sensor::sample::RangeScale;
 use gaitclip::sensor::sample::{AccelRange, GyroRange};
-use gaitclip_board::imu_sampler;
+use gaitclip_board::imu_sampler::{self, asynch};
 use imu_sampler::{BusRecovery, Counters, ImuSampler, Item, ReadMode, RESTART_AFTER, RETRIES};
 
 // Register map (MPU-6000/6050 Register Map rev. 4.2), not imported from the driver.
@@ -61,6 +65,22 @@ impl I2c for Bus {
     }
     fn transaction(&mut self, a: u8, ops: &mut [Operation<'_>]) -> Result<(), ErrorKind> {
         self.mock.transaction(a, ops)
+    }
+}
+
+/// The same mock on the async side: every method forwarded, so the script reads the same.
+impl embedded_hal_async::i2c::I2c for Bus {
+    async fn read(&mut self, a: u8, b: &mut [u8]) -> Result<(), ErrorKind> {
+        embedded_hal_async::i2c::I2c::read(&mut self.mock, a, b).await
+    }
+    async fn write(&mut self, a: u8, b: &[u8]) -> Result<(), ErrorKind> {
+        embedded_hal_async::i2c::I2c::write(&mut self.mock, a, b).await
+    }
+    async fn write_read(&mut self, a: u8, w: &[u8], r: &mut [u8]) -> Result<(), ErrorKind> {
+        embedded_hal_async::i2c::I2c::write_read(&mut self.mock, a, w, r).await
+    }
+    async fn transaction(&mut self, a: u8, ops: &mut [Operation<'_>]) -> Result<(), ErrorKind> {
+        embedded_hal_async::i2c::I2c::transaction(&mut self.mock, a, ops).await
     }
 }
 
@@ -138,6 +158,71 @@ impl Script {
     }
 }
 
+/// Which sampler a scenario runs through.
+#[derive(Clone, Copy, Debug)]
+enum Flavor {
+    Blocking,
+    Async,
+}
+
+const FLAVORS: [Flavor; 2] = [Flavor::Blocking, Flavor::Async];
+
+/// Either sampler behind one face; the async one's futures run to completion at once
+/// (the mock never makes them wait).
+enum Sampler {
+    Blocking(ImuSampler<Bus, NoopDelay>),
+    Async(asynch::ImuSampler<Bus, NoopDelay>),
+}
+
+impl Sampler {
+    /// Starts the sensor over `script`; the mock's handle, to check it was all used.
+    fn start(flavor: Flavor, script: &Script, mode: ReadMode) -> (Mock, Sampler) {
+        let mock = Mock::new(&script.0);
+        let bus = Bus { mock: mock.clone() };
+        let config = Config::new(OutputRate::from_hz(200).unwrap());
+        let sampler = match flavor {
+            Flavor::Blocking => {
+                ImuSampler::start(Mpu6050::new(bus, Address::Ad0Low), NoopDelay, config, mode)
+                    .map(Sampler::Blocking)
+                    .ok()
+            }
+            Flavor::Async => futures_executor::block_on(asynch::ImuSampler::start(
+                gaitclip::mpu6050::asynch::Mpu6050::new(bus, Address::Ad0Low),
+                NoopDelay,
+                config,
+                mode,
+            ))
+            .map(Sampler::Async)
+            .ok(),
+        };
+        let Some(sampler) = sampler else {
+            panic!("the sensor starts ({flavor:?})");
+        };
+        (mock, sampler)
+    }
+
+    fn on_data_ready(&mut self, push: &mut impl FnMut(Item) -> bool) {
+        match self {
+            Sampler::Blocking(s) => s.on_data_ready(push),
+            Sampler::Async(s) => futures_executor::block_on(s.on_data_ready(push)),
+        }
+    }
+
+    fn on_silence(&mut self, periods: u32, push: &mut impl FnMut(Item) -> bool) {
+        match self {
+            Sampler::Blocking(s) => s.on_silence(periods, push),
+            Sampler::Async(s) => futures_executor::block_on(s.on_silence(periods, push)),
+        }
+    }
+
+    fn counters(&self) -> Counters {
+        match self {
+            Sampler::Blocking(s) => s.counters(),
+            Sampler::Async(s) => s.counters(),
+        }
+    }
+}
+
 fn trace() -> Vec<[u8; 14]> {
     let bytes = std::fs::read(
         std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../fixtures/demo_walk.mpu6050"),
@@ -152,18 +237,8 @@ fn trace() -> Vec<[u8; 14]> {
 /// Runs one data-ready pulse per entry of `pulses` through the sampler and every item
 /// through the pipeline, as the firmware's main loop does; checks the bus saw exactly the
 /// script.
-fn run(script: Script, pulses: usize) -> (Vec<Stride>, Vec<Item>, Counters) {
-    let mut mock = Mock::new(&script.0);
-    let bus = Bus { mock: mock.clone() };
-    let config = Config::new(OutputRate::from_hz(200).unwrap());
-    let Ok(mut sampler) = ImuSampler::start(
-        Mpu6050::new(bus, Address::Ad0Low),
-        NoopDelay,
-        config,
-        ReadMode::PerSample,
-    ) else {
-        panic!("the sensor starts");
-    };
+fn run(flavor: Flavor, script: &Script, pulses: usize) -> (Vec<Stride>, Vec<Item>, Counters) {
+    let (mut mock, mut sampler) = Sampler::start(flavor, script, ReadMode::PerSample);
     let rate = SampleRate::from_hz(200).unwrap();
     let mut p = Pipeline::new(gaitclip::pipeline::config::Config::new(
         rate,
@@ -194,7 +269,7 @@ fn clean(n: usize) -> Vec<Stride> {
     for x in &t[..n] {
         s.read(x);
     }
-    run(s, n).0
+    run(Flavor::Blocking, &s, n).0
 }
 
 #[test]
@@ -218,15 +293,21 @@ fn nacks_and_timeouts_are_retried_and_lose_nothing() {
     }
     let nacks = (0..n).filter(|k| k % 500 == 100).count() as u32;
     let timeouts = 2 * (0..n).filter(|k| k % 500 == 300).count() as u32;
-    let (strides, items, c) = run(s, n);
-    assert_eq!(c.bus_errors, nacks + timeouts, "{c:?}");
-    assert_eq!(
-        (c.lost_samples, c.restarts, c.recoveries),
-        (0, 0, 0),
-        "{c:?}"
-    );
-    assert!(items.iter().all(|i| matches!(i, Item::Sample(_))));
-    assert_eq!(strides, clean(n), "retried reads give the same strides");
+    let reference = clean(n);
+    for flavor in FLAVORS {
+        let (strides, items, c) = run(flavor, &s, n);
+        assert_eq!(c.bus_errors, nacks + timeouts, "{flavor:?} {c:?}");
+        assert_eq!(
+            (c.lost_samples, c.restarts, c.recoveries),
+            (0, 0, 0),
+            "{flavor:?} {c:?}"
+        );
+        assert!(items.iter().all(|i| matches!(i, Item::Sample(_))));
+        assert_eq!(
+            strides, reference,
+            "{flavor:?}: retried reads give the same strides"
+        );
+    }
 }
 
 #[test]
@@ -262,83 +343,79 @@ fn a_sensor_that_stops_mid_walk_is_restarted_and_its_stride_marked() {
     for x in &t[stop + OUT..] {
         s.read(x);
     }
-    let pulses = n;
-    let (strides, items, c) = run(s, pulses);
-    assert_eq!(c.bus_errors, (OUT as u32) * (RETRIES + 1) + 2, "{c:?}");
-    assert_eq!((c.restarts, c.recoveries), (1, 3), "{c:?}");
-    assert_eq!(c.lost_samples, OUT as u32, "{c:?}");
-    // Every pulse is a sample or part of a gap; the gap is where the outage was.
-    let gaps: Vec<(usize, u32)> = items
-        .iter()
-        .enumerate()
-        .filter_map(|(k, i)| match i {
-            Item::Gap(g) => Some((k, *g)),
-            Item::Sample(_) | Item::Asleep | Item::Woke(_) => None,
-        })
-        .collect();
-    assert_eq!(gaps, vec![(stop, OUT as u32)]);
-    assert_eq!(items.len() - 1, n - OUT);
-    // The stride across the outage (25 ms: longer than the bridge limit, short enough to
-    // fill): reported once, a gap stride without a measured length, at its place, its
-    // length estimated from the two measured gait cycles before it.
-    const {
+    for flavor in FLAVORS {
+        let (strides, items, c) = run(flavor, &s, n);
+        assert_eq!(
+            c.bus_errors,
+            (OUT as u32) * (RETRIES + 1) + 2,
+            "{flavor:?} {c:?}"
+        );
+        assert_eq!((c.restarts, c.recoveries), (1, 3), "{flavor:?} {c:?}");
+        assert_eq!(c.lost_samples, OUT as u32, "{flavor:?} {c:?}");
+        // Every pulse is a sample or part of a gap; the gap is where the outage was.
+        let gaps: Vec<(usize, u32)> = items
+            .iter()
+            .enumerate()
+            .filter_map(|(k, i)| match i {
+                Item::Gap(g) => Some((k, *g)),
+                Item::Sample(_) | Item::Asleep | Item::Woke(_) => None,
+            })
+            .collect();
+        assert_eq!(gaps, vec![(stop, OUT as u32)]);
+        assert_eq!(items.len() - 1, n - OUT);
+        // The stride across the outage (25 ms: longer than the bridge limit, short enough to
+        // fill): reported once, a gap stride without a measured length, at its place, its
+        // length estimated from the two measured gait cycles before it.
+        const {
+            assert!(
+                OUT as u32 * 5 > gaitclip::pipeline::config::BRIDGE_MAX_MS
+                    && OUT as u32 * 5 <= gaitclip::pipeline::config::FILL_MAX_MS
+            )
+        };
+        let gap: Vec<&Stride> = strides
+            .iter()
+            .filter(|s| s.flags.has(StrideFlags::GAP))
+            .collect();
+        assert_eq!(gap.len(), 1, "{strides:#?}");
+        assert_eq!((gap[0].start, gap[0].end), (mid.start, mid.end));
+        let cycles: Vec<u32> = strides
+            .iter()
+            .take_while(|s| s.index < gap[0].index)
+            .filter(|s| {
+                s.flags.valid()
+                    && !s
+                        .flags
+                        .has(StrideFlags::FROM_REST | StrideFlags::TO_REST | StrideFlags::GAP)
+            })
+            .map(|s| s.length_mm)
+            .collect();
+        let last_two = &cycles[cycles.len().saturating_sub(2)..];
+        assert_eq!(last_two.len(), 2, "{strides:#?}");
         assert!(
-            OUT as u32 * 5 > gaitclip::pipeline::config::BRIDGE_MAX_MS
-                && OUT as u32 * 5 <= gaitclip::pipeline::config::FILL_MAX_MS
-        )
-    };
-    let gap: Vec<&Stride> = strides
-        .iter()
-        .filter(|s| s.flags.has(StrideFlags::GAP))
-        .collect();
-    assert_eq!(gap.len(), 1, "{strides:#?}");
-    assert_eq!((gap[0].start, gap[0].end), (mid.start, mid.end));
-    let cycles: Vec<u32> = strides
-        .iter()
-        .take_while(|s| s.index < gap[0].index)
-        .filter(|s| {
-            s.flags.valid()
-                && !s
-                    .flags
-                    .has(StrideFlags::FROM_REST | StrideFlags::TO_REST | StrideFlags::GAP)
-        })
-        .map(|s| s.length_mm)
-        .collect();
-    let last_two = &cycles[cycles.len().saturating_sub(2)..];
-    assert_eq!(last_two.len(), 2, "{strides:#?}");
-    assert!(
-        !gap[0].flags.valid()
-            && gap[0].flags.has(StrideFlags::ESTIMATED)
-            && gap[0].flags.counts_distance()
-            && gap[0].length_mm == (last_two[0] + last_two[1]).div_ceil(2),
-        "{:?} after {last_two:?}",
-        gap[0]
-    );
-    // Before it, nothing changed; after it, every stride is found again at the same place.
-    assert_eq!(strides.len(), reference.len());
-    for (a, b) in reference.iter().zip(&strides) {
-        if a.end < mid.start {
-            assert_eq!(a, b);
-        } else if a.start > mid.end {
-            assert_eq!((a.start, a.end), (b.start, b.end));
-            assert!(a.zupt_um.abs_diff(b.zupt_um) <= 10_000, "{a:?} vs {b:?}");
-            assert!(b.flags.valid() == a.flags.valid(), "{a:?} vs {b:?}");
+            !gap[0].flags.valid()
+                && gap[0].flags.has(StrideFlags::ESTIMATED)
+                && gap[0].flags.counts_distance()
+                && gap[0].length_mm == (last_two[0] + last_two[1]).div_ceil(2),
+            "{:?} after {last_two:?}",
+            gap[0]
+        );
+        // Before it, nothing changed; after it, every stride is found again at the same place.
+        assert_eq!(strides.len(), reference.len());
+        for (a, b) in reference.iter().zip(&strides) {
+            if a.end < mid.start {
+                assert_eq!(a, b);
+            } else if a.start > mid.end {
+                assert_eq!((a.start, a.end), (b.start, b.end));
+                assert!(a.zupt_um.abs_diff(b.zupt_um) <= 10_000, "{a:?} vs {b:?}");
+                assert!(b.flags.valid() == a.flags.valid(), "{a:?} vs {b:?}");
+            }
         }
     }
 }
 
 /// The sampler in FIFO mode over the mock, batch of 4 pulses per read.
-fn fifo_sampler(script: &Script) -> (Mock, ImuSampler<Bus, NoopDelay>) {
-    let mock = Mock::new(&script.0);
-    let Ok(sampler) = ImuSampler::start(
-        Mpu6050::new(Bus { mock: mock.clone() }, Address::Ad0Low),
-        NoopDelay,
-        Config::new(OutputRate::from_hz(200).unwrap()),
-        ReadMode::Fifo { batch: 4 },
-    ) else {
-        panic!("the sensor starts");
-    };
-    (mock, sampler)
+fn fifo_sampler(flavor: Flavor, script: &Script) -> (Mock, Sampler) {
+    Sampler::start(flavor, script, ReadMode::Fifo { batch: 4 })
 }
 
 #[test]
@@ -351,32 +428,34 @@ fn a_fifo_overflow_becomes_a_gap_of_what_it_cost() {
     // bus): it is reset, and the four samples pulsed since the last read are lost.
     s.fifo_overflowed();
     s.fifo(&t[8..12]);
-    let (mut mock, mut sampler) = fifo_sampler(&s);
-    let mut items = Vec::new();
-    for _ in 0..12 {
-        sampler.on_data_ready(&mut |i| {
-            items.push(i);
-            true
-        });
+    for flavor in FLAVORS {
+        let (mut mock, mut sampler) = fifo_sampler(flavor, &s);
+        let mut items = Vec::new();
+        for _ in 0..12 {
+            sampler.on_data_ready(&mut |i| {
+                items.push(i);
+                true
+            });
+        }
+        mock.done();
+        let c = sampler.counters();
+        assert_eq!(
+            (c.fifo_overflows, c.lost_samples, c.bus_errors),
+            (1, 4, 0),
+            "{flavor:?} {c:?}"
+        );
+        let want: Vec<Item> = t[0..4]
+            .iter()
+            .map(|x| Item::Sample(gaitclip::sensor::sample::RawSample::from_be_bytes(x)))
+            .chain([Item::Gap(4)])
+            .chain(
+                t[8..12]
+                    .iter()
+                    .map(|x| Item::Sample(gaitclip::sensor::sample::RawSample::from_be_bytes(x))),
+            )
+            .collect();
+        assert_eq!(items, want);
     }
-    mock.done();
-    let c = sampler.counters();
-    assert_eq!(
-        (c.fifo_overflows, c.lost_samples, c.bus_errors),
-        (1, 4, 0),
-        "{c:?}"
-    );
-    let want: Vec<Item> = t[0..4]
-        .iter()
-        .map(|x| Item::Sample(gaitclip::sensor::sample::RawSample::from_be_bytes(x)))
-        .chain([Item::Gap(4)])
-        .chain(
-            t[8..12]
-                .iter()
-                .map(|x| Item::Sample(gaitclip::sensor::sample::RawSample::from_be_bytes(x))),
-        )
-        .collect();
-    assert_eq!(items, want);
 }
 
 #[test]
@@ -389,27 +468,29 @@ fn a_silent_sensor_found_by_the_watchdog_is_set_up_again_and_the_silence_is_a_ga
     // the bus is recovered and the sensor set up again.
     s.init_fifo();
     s.fifo(&t[70..74]);
-    let (mut mock, mut sampler) = fifo_sampler(&s);
-    let mut items = Vec::new();
-    let mut push = |i| {
-        items.push(i);
-        true
-    };
-    for _ in 0..6 {
-        sampler.on_data_ready(&mut push);
+    for flavor in FLAVORS {
+        let (mut mock, mut sampler) = fifo_sampler(flavor, &s);
+        let mut items = Vec::new();
+        let mut push = |i| {
+            items.push(i);
+            true
+        };
+        for _ in 0..6 {
+            sampler.on_data_ready(&mut push);
+        }
+        // Two pulses were counted but never read: they are part of the silence's gap.
+        sampler.on_silence(60, &mut push);
+        for _ in 0..4 {
+            sampler.on_data_ready(&mut push);
+        }
+        mock.done();
+        let c = sampler.counters();
+        assert_eq!(
+            (c.silences, c.restarts, c.recoveries, c.lost_samples),
+            (1, 1, 1, 62),
+            "{flavor:?} {c:?}"
+        );
+        assert_eq!(items.len(), 4 + 1 + 4);
+        assert_eq!(items[4], Item::Gap(62));
     }
-    // Two pulses were counted but never read: they are part of the silence's gap.
-    sampler.on_silence(60, &mut push);
-    for _ in 0..4 {
-        sampler.on_data_ready(&mut push);
-    }
-    mock.done();
-    let c = sampler.counters();
-    assert_eq!(
-        (c.silences, c.restarts, c.recoveries, c.lost_samples),
-        (1, 1, 1, 62),
-        "{c:?}"
-    );
-    assert_eq!(items.len(), 4 + 1 + 4);
-    assert_eq!(items[4], Item::Gap(62));
 }

@@ -7,7 +7,7 @@ use gaitclip::mpu6050::blocking::Mpu6050;
 use gaitclip::mpu6050::{Address, Config, OutputRate};
 use gaitclip::sensor::rate::SampleRate;
 use gaitclip::sensor::sample::RawSample;
-use gaitclip_board::imu_sampler::{ImuSampler, Item, ReadMode};
+use gaitclip_board::imu_sampler::{asynch, ImuSampler, Item, ReadMode};
 use gaitclip_board::replay_mpu6050::{
     mg_to_counts, motion_between, periods_per_wake, ReplayMpu6050, WakeTick, REPLAY_MOTION_UNIT,
 };
@@ -230,6 +230,23 @@ impl embedded_hal::i2c::I2c for MockBus {
     }
 }
 
+/// The same mock for the async sampler.
+impl embedded_hal_async::i2c::I2c for MockBus {
+    async fn transaction(
+        &mut self,
+        address: u8,
+        operations: &mut [embedded_hal::i2c::Operation<'_>],
+    ) -> Result<(), Self::Error> {
+        embedded_hal_async::i2c::I2c::transaction(&mut self.0, address, operations).await
+    }
+    async fn write(&mut self, address: u8, bytes: &[u8]) -> Result<(), Self::Error> {
+        embedded_hal_async::i2c::I2c::write(&mut self.0, address, bytes).await
+    }
+    async fn write_read(&mut self, address: u8, w: &[u8], r: &mut [u8]) -> Result<(), Self::Error> {
+        embedded_hal_async::i2c::I2c::write_read(&mut self.0, address, w, r).await
+    }
+}
+
 impl gaitclip_board::imu_sampler::BusRecovery for MockBus {
     fn recover_bus(&mut self) -> bool {
         false
@@ -299,8 +316,21 @@ fn sleep_and_wake_on_the_bus_transaction_by_transaction() {
         T::write_read(A, vec![0x74], sample(2)),
         T::write_read(A, vec![0x74], sample(3)),
     ]);
-    let mock = Mock::new(&expected);
     let config = Config::new(OutputRate::from_hz(200).unwrap());
+    let check = |items: &[Item], bus_errors: u32| {
+        let accel_x = |i: &Item| match i {
+            Item::Sample(s) => Some(s.accel[0]),
+            _ => None,
+        };
+        assert_eq!(items.len(), 4, "{items:?}");
+        assert_eq!(accel_x(&items[0]), Some(1));
+        assert_eq!(items[1], Item::Asleep);
+        assert_eq!(items[2], Item::Woke(41));
+        assert_eq!(accel_x(&items[3]), Some(3));
+        assert_eq!(bus_errors, 0);
+    };
+    // The blocking sampler of the bare-metal boards.
+    let mock = Mock::new(&expected);
     let Ok(mut s) = ImuSampler::start(
         Mpu6050::new(MockBus(mock.clone()), Address::Ad0Low),
         NoopDelay,
@@ -317,16 +347,26 @@ fn sleep_and_wake_on_the_bus_transaction_by_transaction() {
     s.on_data_ready(&mut push_into(&mut items));
     s.on_motion(40, 1, &mut push_into(&mut items));
     s.on_data_ready(&mut push_into(&mut items));
-    let accel_x = |i: &Item| match i {
-        Item::Sample(s) => Some(s.accel[0]),
-        _ => None,
+    check(&items, s.counters().bus_errors);
+    s.bus_mut().unwrap().0.done();
+    // The async sampler of the Bluetooth board: the same transactions and items.
+    let mock = Mock::new(&expected);
+    let Ok(mut s) = futures_executor::block_on(asynch::ImuSampler::start(
+        gaitclip::mpu6050::asynch::Mpu6050::new(MockBus(mock.clone()), Address::Ad0Low),
+        NoopDelay,
+        config,
+        ReadMode::Fifo { batch: 1 },
+    )) else {
+        panic!("the sensor starts (async)");
     };
-    assert_eq!(items.len(), 4, "{items:?}");
-    assert_eq!(accel_x(&items[0]), Some(1));
-    assert_eq!(items[1], Item::Asleep);
-    assert_eq!(items[2], Item::Woke(41));
-    assert_eq!(accel_x(&items[3]), Some(3));
-    assert_eq!(s.counters().bus_errors, 0);
+    let mut items = Vec::new();
+    s.request_sleep(1, SLEEP.wake);
+    futures_executor::block_on(s.on_data_ready(&mut push_into(&mut items)));
+    assert!(s.asleep());
+    futures_executor::block_on(s.on_data_ready(&mut push_into(&mut items)));
+    futures_executor::block_on(s.on_motion(40, 1, &mut push_into(&mut items)));
+    futures_executor::block_on(s.on_data_ready(&mut push_into(&mut items)));
+    check(&items, s.counters().bus_errors);
     s.bus_mut().unwrap().0.done();
 }
 

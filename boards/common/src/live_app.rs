@@ -338,19 +338,49 @@ where
         match ImuSampler::start(imu, delay, config, mode) {
             Ok(s) => return s,
             Err((i, d, e)) => {
-                defmt::error!(
-                    "MPU6050 not ready ({}): check the wiring; retrying",
-                    defmt::Debug2Format(&e)
-                );
-                let _ = serial_line::comment(
-                    serial,
-                    format_args!("MPU6050 not ready: check the wiring; retrying"),
-                );
+                report_not_ready(&e, serial);
                 (imu, delay) = (i, d);
                 delay.delay_ms(1000);
             }
         }
     }
+}
+
+/// [`start_sensor`] for the async sampler ([`crate::imu_sampler::asynch`]): the same
+/// retries and reports, the waits awaited.
+pub async fn start_async_sensor<I, D>(
+    mut imu: gaitclip::mpu6050::asynch::Mpu6050<I, gaitclip::mpu6050::mode::Unconfigured>,
+    mut delay: D,
+    config: mpu6050::Config,
+    mode: ReadMode,
+    serial: &mut impl Write,
+) -> crate::imu_sampler::asynch::ImuSampler<I, D>
+where
+    I: embedded_hal_async::i2c::I2c + BusRecovery,
+    D: embedded_hal_async::delay::DelayNs,
+{
+    loop {
+        match crate::imu_sampler::asynch::ImuSampler::start(imu, delay, config, mode).await {
+            Ok(s) => return s,
+            Err((i, d, e)) => {
+                report_not_ready(&e, serial);
+                (imu, delay) = (i, d);
+                delay.delay_ms(1000).await;
+            }
+        }
+    }
+}
+
+/// A failed start, on defmt (with the error) and the serial line.
+fn report_not_ready(e: &impl core::fmt::Debug, serial: &mut impl Write) {
+    defmt::error!(
+        "MPU6050 not ready ({}): check the wiring; retrying",
+        defmt::Debug2Format(e)
+    );
+    let _ = serial_line::comment(
+        serial,
+        format_args!("MPU6050 not ready: check the wiring; retrying"),
+    );
 }
 
 /// Finds a sensor that stopped pulsing.
