@@ -64,7 +64,7 @@ impl GaitTimer {
     /// Sets `stride.gait` (its length already set).
     pub fn process(&mut self, stride: &mut Stride) {
         let previous_heel_strike = match self.previous {
-            Some((end, heel_strike)) if end == stride.start => Some(heel_strike),
+            Some((end, heel_strike)) if end == stride.events.start => Some(heel_strike),
             _ => None,
         };
         stride.gait = GaitParameters::of(stride, previous_heel_strike, self.rate);
@@ -73,7 +73,7 @@ impl GaitTimer {
         self.previous = if stride.flags.has(StrideFlags::GAP) {
             None
         } else {
-            Some((stride.end, stride.heel_strike))
+            Some((stride.events.end, stride.events.heel_strike))
         };
     }
 }
@@ -82,13 +82,20 @@ impl GaitParameters {
     /// The parameters of `stride` (its length already set) at `rate`, with the heel-strike
     /// of the stride before it when that one ended where this one starts.
     pub const fn of(stride: &Stride, previous_heel_strike: Option<u32>, rate: SampleRate) -> Self {
-        let cycle_ms = rate.ms_of_samples(stride.end.wrapping_sub(stride.start));
+        let cycle_ms = rate.ms_of_samples(stride.events.end.wrapping_sub(stride.events.start));
         let stride_ms = match previous_heel_strike {
             // Heel-strikes in order (a detector's always are); otherwise the cycle.
-            Some(p) if p <= stride.heel_strike => rate.ms_of_samples(stride.heel_strike - p),
+            Some(p) if p <= stride.events.heel_strike => {
+                rate.ms_of_samples(stride.events.heel_strike - p)
+            }
             _ => cycle_ms,
         };
-        let swing_ms = rate.ms_of_samples(stride.heel_strike.wrapping_sub(stride.toe_off));
+        let swing_ms = rate.ms_of_samples(
+            stride
+                .events
+                .heel_strike
+                .wrapping_sub(stride.events.toe_off),
+        );
         // Events are ordered within the stride; a swing longer than the cycle is not one.
         let swing_ms = if swing_ms > stride_ms {
             stride_ms
@@ -141,15 +148,18 @@ const fn saturate_u16(v: u64) -> u16 {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::record::stride::StrideEvents;
 
     fn stride(start: u32, toe_off: u32, heel_strike: u32, end: u32, mm: u32) -> Stride {
         Stride {
-            start,
-            heel_off: toe_off.saturating_sub(10).max(start),
-            toe_off,
-            heel_strike,
-            foot_flat: heel_strike,
-            end,
+            events: StrideEvents {
+                start,
+                heel_off: toe_off.saturating_sub(10).max(start),
+                toe_off,
+                heel_strike,
+                foot_flat: heel_strike,
+                end,
+            },
             length_mm: mm,
             ..Stride::default()
         }
@@ -255,7 +265,7 @@ mod tests {
         assert_eq!(g, GaitParameters::default());
         // Events out of order (never made by a detector) cannot underflow.
         let mut s = stride(0, 150, 100, 120, 900);
-        s.heel_off = 0;
+        s.events.heel_off = 0;
         let g = GaitParameters::of(&s, None, rate);
         assert!(g.swing_time_ms <= g.stride_time_ms);
         // A stride of the counter's wrap and a huge length saturate.

@@ -54,7 +54,7 @@ use crate::detect::seam::MAX_STANCE_IN_STRIDE_MS;
 use crate::detect::seam::{DetectConfig, Drain, Input, StepDetector};
 use crate::detect::zupt::{RollingContact, ZuptIntegrator};
 use crate::fixed::{isqrt_u64, QuatQ30};
-use crate::record::stride::{Stride, StrideFlags};
+use crate::record::stride::{Stride, StrideEvents, StrideFlags};
 use crate::sensor::rate::SampleRate;
 use crate::sensor::sample::Origin;
 use crate::sensor::sample::{Rails, RawSample};
@@ -910,12 +910,14 @@ impl<const M: usize> CycleDetector<M> {
         let toe_off = toe_off.min(heel_strike).max(heel_off);
         let mut stride = Stride {
             index,
-            start: cur.start,
-            heel_off: heel_off.min(foot_flat),
-            toe_off,
-            heel_strike,
-            foot_flat,
-            end: c.index,
+            events: StrideEvents {
+                start: cur.start,
+                heel_off: heel_off.min(foot_flat),
+                toe_off,
+                heel_strike,
+                foot_flat,
+                end: c.index,
+            },
             flags: StrideFlags(flags),
             ..Stride::default()
         };

@@ -61,7 +61,7 @@ use heapless::Vec;
 
 use crate::detect::phase_stats::StrideStats;
 use crate::detect::seam::{DetectConfig, Drain, Input, StepDetector};
-use crate::record::stride::{StepAmplitude, Stride, StrideFlags};
+use crate::record::stride::{StepAmplitude, Stride, StrideEvents, StrideFlags};
 use crate::sensor::rate::SampleRate;
 use crate::signal::low_pass::{LowPass, LOW_PASS_LSB_PER_G};
 
@@ -767,12 +767,14 @@ impl PeakValleySteps {
         }
         Stride {
             index: step.index,
-            start: step.peak.index,
-            heel_off: step.peak.index,
-            toe_off: step.peak.index,
-            heel_strike: step.valley.index,
-            foot_flat: step.valley.index,
-            end: step.valley.index,
+            events: StrideEvents {
+                start: step.peak.index,
+                heel_off: step.peak.index,
+                toe_off: step.peak.index,
+                heel_strike: step.valley.index,
+                foot_flat: step.valley.index,
+                end: step.valley.index,
+            },
             flags: StrideFlags(flags),
             ..Stride::default()
         }

@@ -48,7 +48,7 @@ use crate::detect::seam::{
 };
 use crate::detect::stance::{StanceDetector, StanceThresholds};
 use crate::detect::zupt::ZuptIntegrator;
-use crate::record::stride::{Stride, StrideFlags};
+use crate::record::stride::{Stride, StrideEvents, StrideFlags};
 use crate::sensor::rate::SampleRate;
 use crate::sensor::sample::{Origin, Rails, RawSample};
 use crate::sensor::units::{FootAccel, GyroScale};
@@ -227,12 +227,14 @@ impl<const M: usize> StrideTracker<M> {
         self.next_index = self.next_index.wrapping_add(1);
         Stride {
             index,
-            start,
-            heel_off: self.heel_off,
-            toe_off: self.gap_at,
-            heel_strike: self.gap_at,
-            foot_flat: end,
-            end,
+            events: StrideEvents {
+                start,
+                heel_off: self.heel_off,
+                toe_off: self.gap_at,
+                heel_strike: self.gap_at,
+                foot_flat: end,
+                end,
+            },
             flags: StrideFlags(flags),
             ..Stride::default()
         }
@@ -480,12 +482,14 @@ impl<const M: usize> StrideTracker<M> {
         slot.1 = StrideStats::measure(&self.movement, split.toe_off, split.heel_strike);
         let mut held = Stride {
             index,
-            start,
-            heel_off: self.heel_off,
-            toe_off,
-            heel_strike,
-            foot_flat,
-            end: foot_flat,
+            events: StrideEvents {
+                start,
+                heel_off: self.heel_off,
+                toe_off,
+                heel_strike,
+                foot_flat,
+                end: foot_flat,
+            },
             flags: StrideFlags(flags),
             ..Stride::default()
         };
@@ -698,21 +702,32 @@ mod tests {
         let (at, first) = out[0];
         assert_eq!(at, 400, "released by the second heel-off");
         assert_eq!(
-            (first.heel_off, first.foot_flat, first.end),
+            (
+                first.events.heel_off,
+                first.events.foot_flat,
+                first.events.end
+            ),
             (300, 360, 360)
         );
         // From a rest longer than MAX_STANCE_IN_STRIDE_MS: the start is that long before
         // heel-off.
-        assert_eq!(first.start, 300 - 200);
+        assert_eq!(first.events.start, 300 - 200);
         assert!(first.flags.has(StrideFlags::FROM_REST));
         assert!(!first.flags.has(StrideFlags::TO_REST));
-        assert!(first.heel_off < first.toe_off && first.toe_off < first.heel_strike);
-        assert!(first.heel_strike < first.foot_flat);
+        assert!(
+            first.events.heel_off < first.events.toe_off
+                && first.events.toe_off < first.events.heel_strike
+        );
+        assert!(first.events.heel_strike < first.events.foot_flat);
         let (at, second) = out[1];
         // The stance after it ends the walk once it is longer than 1 s (200 samples).
         assert_eq!(at, 460 + 201);
         assert_eq!(
-            (second.start, second.heel_off, second.foot_flat),
+            (
+                second.events.start,
+                second.events.heel_off,
+                second.events.foot_flat
+            ),
             (360, 400, 460)
         );
         assert!(second.flags.has(StrideFlags::TO_REST));
@@ -740,7 +755,10 @@ mod tests {
         assert_eq!(out.len(), 1, "{out:?}");
         let s = out[0].1;
         // The stance kept its start through the wobble.
-        assert_eq!((s.start, s.heel_off, s.foot_flat), (0, 120, 180));
+        assert_eq!(
+            (s.events.start, s.events.heel_off, s.events.foot_flat),
+            (0, 120, 180)
+        );
     }
 
     #[test]
@@ -751,7 +769,7 @@ mod tests {
         let last = t
             .finish()
             .expect("the stride waiting for its stance to end");
-        assert_eq!((last.heel_off, last.foot_flat), (100, 160));
+        assert_eq!((last.events.heel_off, last.events.foot_flat), (100, 160));
         assert!(last.flags.has(StrideFlags::TO_REST));
         assert_eq!(t.finish(), None);
     }
@@ -767,7 +785,7 @@ mod tests {
         assert_eq!(out.len(), 1, "{out:?}");
         let s = out[0].1;
         assert!(s.flags.has(StrideFlags::GAP));
-        assert_eq!((s.heel_off, s.end), (100, 160));
+        assert_eq!((s.events.heel_off, s.events.end), (100, 160));
     }
 
     #[test]
@@ -792,7 +810,7 @@ mod tests {
         let (mut t, mut n) = (tracker(), 0);
         feed(&mut t, &mut n, &[(true, 100), (false, 60), (true, 20)]);
         let held = t.gap().expect("the stride waiting for its stance to end");
-        assert_eq!((held.heel_off, held.foot_flat), (100, 160));
+        assert_eq!((held.events.heel_off, held.events.foot_flat), (100, 160));
         assert!(!held.flags.has(StrideFlags::GAP));
     }
 

@@ -68,7 +68,7 @@ impl LengthEstimator {
     /// make its length invalid gets the estimate (see the [module](self)) and
     /// [`StrideFlags::ESTIMATED`], unless nothing was measured yet. Never panics.
     pub fn process(&mut self, s: &mut Stride) {
-        let duration = s.end.wrapping_sub(s.start);
+        let duration = s.events.end.wrapping_sub(s.events.start);
         if duration == 0 || duration > u32::MAX / 2 {
             return;
         }

@@ -165,7 +165,8 @@ impl Features {
             f[duration_index(seg)] = duration_q16(s.samples, rate);
             f[frequency_index(seg)] = frequency_q16(s.samples, rate);
         }
-        f[STRIDE_FREQUENCY] = frequency_q16(stride.end.wrapping_sub(stride.start), rate);
+        f[STRIDE_FREQUENCY] =
+            frequency_q16(stride.events.end.wrapping_sub(stride.events.start), rate);
         f[ZUPT_LENGTH] = zupt_length_q16(stride);
         Features(f)
     }

@@ -81,11 +81,11 @@ impl StrideFlags {
     }
 }
 
-/// One stride. Indices are sample numbers since the pipeline started.
+/// A stride's gait events: the one definition of them that the stride record, its logs and
+/// the host's evaluation share. Indices are sample numbers since the pipeline started; in
+/// order, `start ≤ heel_off ≤ toe_off ≤ heel_strike ≤ foot_flat ≤ end`.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
-pub struct Stride {
-    /// Running stride number, from 0.
-    pub index: u32,
+pub struct StrideEvents {
     /// First sample (a foot-flat, or at most [`MAX_STANCE_IN_STRIDE_MS`](crate::detect::seam::MAX_STANCE_IN_STRIDE_MS) before heel-off).
     pub start: u32,
     /// End of stance: first sample of the movement.
@@ -100,6 +100,44 @@ pub struct Stride {
     /// The stride's exclusive end, the next stride's start: the next foot-flat (stance
     /// detector) or the next stance instant (cycle detector).
     pub end: u32,
+}
+
+impl StrideEvents {
+    /// Every event mapped by `f` (from core sample numbers to a recording's indices across
+    /// its holes, say).
+    pub fn map(self, f: impl Fn(u32) -> u32) -> Self {
+        StrideEvents {
+            start: f(self.start),
+            heel_off: f(self.heel_off),
+            toe_off: f(self.toe_off),
+            heel_strike: f(self.heel_strike),
+            foot_flat: f(self.foot_flat),
+            end: f(self.end),
+        }
+    }
+
+    /// The stride's times at `rate`. The four phases add up to the duration (each interval
+    /// is rounded on its own, so they may differ from it by a millisecond or two).
+    pub fn times_ms(&self, rate: SampleRate) -> StrideTimesMs {
+        let ms = |a: u32, b: u32| rate.ms_of_samples(b.wrapping_sub(a));
+        StrideTimesMs {
+            start: rate.ms_of_samples(self.start),
+            duration: ms(self.start, self.end),
+            stance: ms(self.start, self.heel_off),
+            push_off: ms(self.heel_off, self.toe_off),
+            swing: ms(self.toe_off, self.heel_strike),
+            heel_strike: ms(self.heel_strike, self.end),
+        }
+    }
+}
+
+/// One stride. Indices are sample numbers since the pipeline started.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
+pub struct Stride {
+    /// Running stride number, from 0.
+    pub index: u32,
+    /// Its gait events.
+    pub events: StrideEvents,
     /// Length of the stride, mm, from the pipeline's length model
     /// ([`crate::length::models`]); 0 until the pipeline sets it.
     pub length_mm: u32,
@@ -141,18 +179,9 @@ pub struct StrideTimesMs {
 }
 
 impl Stride {
-    /// The stride's times at `rate`. The four phases add up to the duration (each interval
-    /// is rounded on its own, so they may differ from it by a millisecond or two).
+    /// The stride's times at `rate` ([`StrideEvents::times_ms`]).
     pub fn times_ms(&self, rate: SampleRate) -> StrideTimesMs {
-        let ms = |a: u32, b: u32| rate.ms_of_samples(b.wrapping_sub(a));
-        StrideTimesMs {
-            start: rate.ms_of_samples(self.start),
-            duration: ms(self.start, self.end),
-            stance: ms(self.start, self.heel_off),
-            push_off: ms(self.heel_off, self.toe_off),
-            swing: ms(self.toe_off, self.heel_strike),
-            heel_strike: ms(self.heel_strike, self.end),
-        }
+        self.events.times_ms(rate)
     }
 
     /// Sets the length, clamped to [`MAX_STRIDE_MM`] and flagged
@@ -181,13 +210,13 @@ mod tests {
 
     #[test]
     fn times_are_the_intervals_between_the_events() {
-        let s = Stride {
+        let s = StrideEvents {
             start: 200,
             heel_off: 210,
             toe_off: 240,
             heel_strike: 301,
             end: 400,
-            ..Stride::default()
+            ..StrideEvents::default()
         };
         let t = s.times_ms(SampleRate::from_hz(200).unwrap());
         assert_eq!(
@@ -202,9 +231,9 @@ mod tests {
             }
         );
         // A 204.8 Hz recording: 1024 samples are exactly 5 s.
-        let t = Stride {
+        let t = StrideEvents {
             end: 1024,
-            ..Stride::default()
+            ..StrideEvents::default()
         }
         .times_ms(SampleRate::from_millihertz(204_800).unwrap());
         assert_eq!(t.duration, 5000);

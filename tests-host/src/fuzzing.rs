@@ -109,12 +109,18 @@ pub fn core_pipeline(data: &[u8]) {
     }
     strides.extend(std::iter::from_fn(|| p.finish()));
     for (k, s) in strides.iter().enumerate() {
-        assert!(s.start <= s.heel_off && s.heel_off <= s.toe_off, "{s:?}");
         assert!(
-            s.toe_off <= s.heel_strike && s.heel_strike <= s.end,
+            s.events.start <= s.events.heel_off && s.events.heel_off <= s.events.toe_off,
             "{s:?}"
         );
-        assert!(s.start < s.end && s.end <= p.next_index(), "{s:?}");
+        assert!(
+            s.events.toe_off <= s.events.heel_strike && s.events.heel_strike <= s.events.end,
+            "{s:?}"
+        );
+        assert!(
+            s.events.start < s.events.end && s.events.end <= p.next_index(),
+            "{s:?}"
+        );
         assert!(s.length_mm <= MAX_STRIDE_MM, "{s:?}");
         // Nothing measured across a gap: the length is the estimate, or none.
         assert!(

@@ -172,11 +172,14 @@ fn serial_stride_line_parses_back() {
     let rate = SampleRate::from_hz(200).unwrap();
     let mut stride = gaitclip::record::stride::Stride {
         index: 7,
-        start: 1000,
-        heel_off: 1084,
-        toe_off: 1114,
-        heel_strike: 1190,
-        end: 1221,
+        events: gaitclip::record::stride::StrideEvents {
+            start: 1000,
+            heel_off: 1084,
+            toe_off: 1114,
+            heel_strike: 1190,
+            end: 1221,
+            ..gaitclip::record::stride::StrideEvents::default()
+        },
         length_mm: 1362,
         climb_mm: -3,
         ..Default::default()

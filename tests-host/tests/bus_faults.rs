@@ -317,7 +317,7 @@ fn a_sensor_that_stops_mid_walk_is_restarted_and_its_stride_marked() {
     let reference = clean(n);
     // Stop in the swing of a stride in the middle of the walk.
     let mid = reference[reference.len() / 2];
-    let stop = ((mid.toe_off + mid.heel_strike) / 2) as usize;
+    let stop = ((mid.events.toe_off + mid.events.heel_strike) / 2) as usize;
     // Out for OUT periods: each read fails all its attempts; from the RESTART_AFTER-th
     // failed period on, each one recovers the bus and tries a set-up: the first finds
     // nobody, the second a part that is not an MPU6050 (the bus still settling), the third
@@ -377,7 +377,10 @@ fn a_sensor_that_stops_mid_walk_is_restarted_and_its_stride_marked() {
             .filter(|s| s.flags.has(StrideFlags::GAP))
             .collect();
         assert_eq!(gap.len(), 1, "{strides:#?}");
-        assert_eq!((gap[0].start, gap[0].end), (mid.start, mid.end));
+        assert_eq!(
+            (gap[0].events.start, gap[0].events.end),
+            (mid.events.start, mid.events.end)
+        );
         let cycles: Vec<u32> = strides
             .iter()
             .take_while(|s| s.index < gap[0].index)
@@ -402,10 +405,13 @@ fn a_sensor_that_stops_mid_walk_is_restarted_and_its_stride_marked() {
         // Before it, nothing changed; after it, every stride is found again at the same place.
         assert_eq!(strides.len(), reference.len());
         for (a, b) in reference.iter().zip(&strides) {
-            if a.end < mid.start {
+            if a.events.end < mid.events.start {
                 assert_eq!(a, b);
-            } else if a.start > mid.end {
-                assert_eq!((a.start, a.end), (b.start, b.end));
+            } else if a.events.start > mid.events.end {
+                assert_eq!(
+                    (a.events.start, a.events.end),
+                    (b.events.start, b.events.end)
+                );
                 assert!(a.zupt_um.abs_diff(b.zupt_um) <= 10_000, "{a:?} vs {b:?}");
                 assert!(b.flags.valid() == a.flags.valid(), "{a:?} vs {b:?}");
             }

@@ -52,8 +52,8 @@ fn cycle_strides_match_the_f64_twin_within_1_mm() {
                             e <= 1e-3,
                             "{name} {} stride {k} ({}..{}): core {} µm, f64 {:.0} µm",
                             trial.name,
-                            s.start,
-                            s.end,
+                            s.events.start,
+                            s.events.end,
                             s.zupt_um,
                             m * 1e6
                         );

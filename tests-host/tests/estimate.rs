@@ -2,15 +2,18 @@
 //! every stride the detector finds counts in the distance.
 
 use gaitclip::length::estimate::LengthEstimator;
-use gaitclip::record::stride::{Stride, StrideFlags};
+use gaitclip::record::stride::{Stride, StrideEvents, StrideFlags};
 use gaitclip_host::io::datasets::root_or_skip;
 use gaitclip_host::io::trace::Ranges;
 use gaitclip_host::{io::csv_trace, io::datasets, replay};
 
 fn stride(start: u32, end: u32, length_mm: u32, flags: u16) -> Stride {
     Stride {
-        start,
-        end,
+        events: StrideEvents {
+            start,
+            end,
+            ..StrideEvents::default()
+        },
         length_mm,
         flags: StrideFlags(flags),
         ..Stride::default()

@@ -399,21 +399,21 @@ fn qemu_m4_sleeps_when_still_and_wakes_as_the_host_model() {
         let twin = awake
             .iter()
             .map(|a| &a.raw)
-            .find(|a| a.start + held == s.start)
+            .find(|a| a.events.start + held == s.events.start)
             .unwrap_or_else(|| panic!("no stride of the awake replay matches {s:#?}"));
         assert_eq!(
-            (s.length_mm, s.end, s.heel_strike, s.flags),
+            (s.length_mm, s.events.end, s.events.heel_strike, s.flags),
             (
                 twin.length_mm,
-                twin.end + held,
-                twin.heel_strike + held,
+                twin.events.end + held,
+                twin.events.heel_strike + held,
                 twin.flags
             )
         );
         if k == 0 {
             assert_eq!(
                 u32::from(s.gait.stride_time_ms),
-                config.rate.ms_of_samples(s.end - s.start)
+                config.rate.ms_of_samples(s.events.end - s.events.start)
             );
         } else {
             assert_eq!(s.gait, twin.gait);

@@ -6,7 +6,7 @@ use gaitclip::fixed::{exp_neg_q32, root_q16, tenth_root_q16};
 use gaitclip::length::features::{self, Features, COUNT};
 use gaitclip::length::fuzzy::{lu_k_q16, D_UNIVERSE_Q16, F_UNIVERSE_Q16};
 use gaitclip::length::models::{self, Model, Settings, MAX_TERMS};
-use gaitclip::record::stride::Stride;
+use gaitclip::record::stride::{Stride, StrideEvents};
 use gaitclip::sensor::rate::SampleRate;
 use gaitclip::sensor::sample::RangeScale;
 use gaitclip_host::reference::length_ref;
@@ -146,9 +146,12 @@ fn random_strides(n: usize) -> Vec<(Stride, StrideStats)> {
             let stance = r.random_range(0..300u32);
             (
                 Stride {
-                    start: 1000,
-                    heel_off: 1000 + stance,
-                    end: 1000 + stance + len as u32,
+                    events: StrideEvents {
+                        start: 1000,
+                        heel_off: 1000 + stance,
+                        end: 1000 + stance + len as u32,
+                        ..StrideEvents::default()
+                    },
                     zupt_um: r.random_range(0..3_000_000),
                     ..Stride::default()
                 },

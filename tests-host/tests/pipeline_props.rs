@@ -69,19 +69,22 @@ fn check<const M: usize>(
     strides.extend(std::iter::from_fn(|| p.finish()));
     let buffer_ms = M as u64 * 1000 / rate_hz as u64;
     for (k, s) in strides.iter().enumerate() {
-        assert!(s.start <= s.heel_off && s.heel_off <= s.toe_off, "{s:?}");
         assert!(
-            s.toe_off <= s.heel_strike && s.heel_strike <= s.end,
+            s.events.start <= s.events.heel_off && s.events.heel_off <= s.events.toe_off,
             "{s:?}"
         );
-        assert!(s.start < s.end, "{s:?}");
+        assert!(
+            s.events.toe_off <= s.events.heel_strike && s.events.heel_strike <= s.events.end,
+            "{s:?}"
+        );
+        assert!(s.events.start < s.events.end, "{s:?}");
         // A gap stride's events after the gap are unknown (set to the gap, which may be its
         // end when the recording stops in it); every other stride ends after heel-strike.
         assert!(
-            s.heel_strike < s.end || s.flags.has(StrideFlags::GAP),
+            s.events.heel_strike < s.events.end || s.flags.has(StrideFlags::GAP),
             "{s:?}"
         );
-        assert!(s.end <= p.next_index(), "{s:?}");
+        assert!(s.events.end <= p.next_index(), "{s:?}");
         assert!(s.length_mm <= MAX_STRIDE_MM, "{s:?}");
         if s.flags.has(StrideFlags::GAP) {
             // No length measured across a gap: the length is the estimate, or none.
@@ -93,14 +96,14 @@ fn check<const M: usize>(
         }
         // The movement buffer holds M samples of heel-off to foot-flat; a longer movement is
         // flagged, not grown.
-        let moved_ms = (s.foot_flat - s.heel_off) as u64 * 1000 / rate_hz as u64;
+        let moved_ms = (s.events.foot_flat - s.events.heel_off) as u64 * 1000 / rate_hz as u64;
         if moved_ms > buffer_ms + 1 && !s.flags.has(StrideFlags::GAP) {
             assert!(s.flags.has(StrideFlags::TOO_LONG), "{s:?}");
         }
         if k > 0 {
             assert!(s.index == strides[k - 1].index + 1);
             assert!(
-                s.start >= strides[k - 1].end || s.flags.has(StrideFlags::FROM_REST),
+                s.events.start >= strides[k - 1].events.end || s.flags.has(StrideFlags::FROM_REST),
                 "{s:?}"
             );
         }
@@ -142,9 +145,9 @@ proptest! {
         // last before rest: a gap in that stance leaves the question open.
         let gap_end = at as u32 + missing;
         for w in &whole {
-            let before = w.end + 210 < at as u32;
+            let before = w.events.end + 210 < at as u32;
             if before {
-                let c = cut.iter().find(|c| c.start == w.start).unwrap_or_else(|| panic!("{w:?} lost"));
+                let c = cut.iter().find(|c| c.events.start == w.events.start).unwrap_or_else(|| panic!("{w:?} lost"));
                 prop_assert_eq!(c.length_mm, w.length_mm);
                 prop_assert_eq!(c.flags, w.flags);
             }
@@ -155,7 +158,7 @@ proptest! {
         let rate = SampleRate::from_hz(200).unwrap();
         let (bridge, fill) = (rate.samples_in_ms(BRIDGE_MAX_MS), rate.samples_in_ms(FILL_MAX_MS));
         for c in &cut {
-            if c.start < at as u32 && c.end > at as u32 {
+            if c.events.start < at as u32 && c.events.end > at as u32 {
                 let bridged = c.flags.has(StrideFlags::BRIDGED);
                 let gap = c.flags.has(StrideFlags::GAP);
                 if missing <= bridge {

@@ -33,16 +33,20 @@ fn compare(name: &str, trace: &Trace, method: PhaseMethod) -> Vec<u32> {
     );
     let mut diffs = Vec::new();
     for (c, r) in core.iter().zip(&refr) {
-        let overlap = c.end.min(r.end).saturating_sub(c.heel_off.max(r.heel_off));
+        let overlap = c
+            .events
+            .end
+            .min(r.events.end)
+            .saturating_sub(c.events.heel_off.max(r.events.heel_off));
         assert!(
-            2 * overlap >= (c.end - c.heel_off).min(r.end - r.heel_off),
+            2 * overlap >= (c.events.end - c.events.heel_off).min(r.events.end - r.events.heel_off),
             "{name} {method:?}: different strides\n core {c:?}\n ref  {r:?}"
         );
         let d = [
-            c.heel_off.abs_diff(r.heel_off),
-            c.toe_off.abs_diff(r.toe_off),
-            c.heel_strike.abs_diff(r.heel_strike),
-            c.end.abs_diff(r.end),
+            c.events.heel_off.abs_diff(r.events.heel_off),
+            c.events.toe_off.abs_diff(r.events.toe_off),
+            c.events.heel_strike.abs_diff(r.events.heel_strike),
+            c.events.end.abs_diff(r.events.end),
         ];
         if d.iter().any(|&x| x > 1) {
             eprintln!("  {name} {method:?}: events differ by {d:?}\n core {c:?}\n ref  {r:?}");

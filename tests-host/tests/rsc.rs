@@ -7,7 +7,7 @@
 //! flags & 0x02; running if flags & 0x04.
 
 use gaitclip::record::gait::{Gait, GaitParameters};
-use gaitclip::record::stride::{Stride, StrideFlags};
+use gaitclip::record::stride::{Stride, StrideEvents, StrideFlags};
 use gaitclip_board::rsc::{self, ControlPointRefusal, FootPod, Measurement};
 
 /// What Nordic's decoder reads from a notification: running, speed m/s, cadence, stride
@@ -68,12 +68,14 @@ fn measurement_matches_nordics_test_vector() {
 
 fn stride(length_mm: u32, gait: Gait, flags: u16) -> Stride {
     let mut s = Stride {
-        start: 0,
-        heel_off: 40,
-        toe_off: 60,
-        heel_strike: 140,
-        foot_flat: 160,
-        end: 220,
+        events: StrideEvents {
+            start: 0,
+            heel_off: 40,
+            toe_off: 60,
+            heel_strike: 140,
+            foot_flat: 160,
+            end: 220,
+        },
         length_mm,
         flags: StrideFlags(flags),
         ..Stride::default()

@@ -138,7 +138,10 @@ fn advertising_data_names_the_rsc_service() {
 fn strides_count_without_a_central() {
     let link = PodLink::new();
     let mut s = gaitclip::record::stride::Stride {
-        end: 220,
+        events: gaitclip::record::stride::StrideEvents {
+            end: 220,
+            ..gaitclip::record::stride::StrideEvents::default()
+        },
         length_mm: 1400,
         ..Default::default()
     };

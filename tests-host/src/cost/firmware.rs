@@ -112,7 +112,13 @@ impl LoggedStride {
         let g = &s.gait;
         LoggedStride {
             index: s.index,
-            idx: [s.start, s.heel_off, s.toe_off, s.heel_strike, s.end],
+            idx: [
+                s.events.start,
+                s.events.heel_off,
+                s.events.toe_off,
+                s.events.heel_strike,
+                s.events.end,
+            ],
             length_mm: s.length_mm,
             climb_mm: s.climb_mm,
             flags: s.flags.0,

@@ -123,17 +123,18 @@ fn clamp_trace(t: &Trace, g: f64) -> Trace {
 
 /// The unclipped stride between the same two instants as `s`.
 fn same_instants<'a>(s: &Stride, refs: &'a [Stride]) -> Option<&'a Stride> {
-    refs.iter().find(|r| r.start == s.start && r.end == s.end)
+    refs.iter()
+        .find(|r| r.events.start == s.events.start && r.events.end == s.events.end)
 }
 
 fn position(s: &Stride, at: &[u32]) -> Position {
     let mut n = [0usize; 4];
     for &i in at {
-        let p = if i < s.heel_off {
+        let p = if i < s.events.heel_off {
             0
-        } else if i < s.toe_off {
+        } else if i < s.events.toe_off {
             1
-        } else if i < s.heel_strike {
+        } else if i < s.events.heel_strike {
             2
         } else {
             3
@@ -192,7 +193,7 @@ pub fn sweep(dataset: &datasets::Dataset, clipping: &Clipping) -> Result<SweepRe
             let at: Vec<u32> = clipped_at
                 .iter()
                 .copied()
-                .filter(|&i| i > s.start && i <= s.end)
+                .filter(|&i| i > s.events.start && i <= s.events.end)
                 .collect();
             let m = |x: &Stride| x.zupt_um as f64 / 1e6;
             out.strides.push(ClippedStride {

@@ -108,7 +108,7 @@ fn compare_trial(
     let span = trial.span_in_numbers(clock);
     let in_span: Vec<&Stride> = strides
         .iter()
-        .filter(|s| s.heel_off < span.1 && s.foot_flat > span.0)
+        .filter(|s| s.events.heel_off < span.1 && s.events.foot_flat > span.0)
         .collect();
     let det: Vec<Detected> = in_span.iter().map(|s| Detected::from(*s)).collect();
     let refs = trial.references_in_numbers(clock);
@@ -189,8 +189,8 @@ fn compare_trial(
         }
         if let Some(pos) = &trial.positions {
             let (r0, r1) = (
-                clock.row_of_number(s.start) as usize,
-                clock.row_of_number(s.end) as usize,
+                clock.row_of_number(s.events.start) as usize,
+                clock.row_of_number(s.events.end) as usize,
             );
             if r1 >= pos.len() || r1 <= r0 {
                 continue;
@@ -200,7 +200,7 @@ fn compare_trial(
                 continue;
             }
             let (a, b) = (pos[r0], pos[r1]);
-            let t_s = (s.end - s.start) as f64 * clock.period_s;
+            let t_s = (s.events.end - s.events.start) as f64 * clock.period_s;
             let speed = ((b[0] - a[0]).powi(2) + (b[1] - a[1]).powi(2)).sqrt() / t_s;
             let top = span.iter().map(|p| p[2]).fold(f64::MIN, f64::max) - a[2];
             let pace = pace_of(speed);

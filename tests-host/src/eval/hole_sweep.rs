@@ -172,7 +172,7 @@ fn walk(dataset: &str, trial: &datasets::Trial, t: &Trace, decimate: usize) -> R
         let (s, r) = (&strides[i], &scaled[j]);
         let informational = StrideFlags::FROM_REST | StrideFlags::TO_REST | StrideFlags::TURN;
         let Some(len) = r.length_m else { continue };
-        let secs = (s.end - s.start) as f64 * period_ms / 1e3;
+        let secs = (s.events.end - s.events.start) as f64 * period_ms / 1e3;
         if !r.flagged
             && s.flags.valid()
             && !s.flags.has(informational)
@@ -195,9 +195,9 @@ fn walk(dataset: &str, trial: &datasets::Trial, t: &Trace, decimate: usize) -> R
 /// The first sample of each hole of `p` in `s`.
 fn holes_in(s: &Stride, p: Pattern) -> Vec<u32> {
     let at = if p.swing {
-        (s.toe_off + s.heel_strike) / 2
+        (s.events.toe_off + s.events.heel_strike) / 2
     } else {
-        (s.start + s.heel_off) / 2
+        (s.events.start + s.events.heel_off) / 2
     };
     let n = if p.cluster { CLUSTER } else { 1 };
     // Centred on the middle of the phase.
@@ -266,15 +266,18 @@ pub fn matching_stride<'a>(want: &Stride, got: &'a [Stride]) -> Option<&'a Strid
         .iter()
         .map(|g| {
             let ov = want
+                .events
                 .end
-                .min(g.end)
-                .saturating_sub(want.heel_off.max(g.heel_off));
+                .min(g.events.end)
+                .saturating_sub(want.events.heel_off.max(g.events.heel_off));
             (ov, g)
         })
         .max_by_key(|x| x.0);
     match m {
         Some((ov, g))
-            if 2 * ov >= (want.end - want.heel_off).max(g.end.saturating_sub(g.heel_off)) =>
+            if 2 * ov
+                >= (want.events.end - want.events.heel_off)
+                    .max(g.events.end.saturating_sub(g.events.heel_off)) =>
         {
             Some(g)
         }
@@ -295,12 +298,13 @@ fn compare(want: &Stride, got: &[Stride], period_ms: f64) -> Cost {
                 .push(g.length_mm.abs_diff(want.length_mm) as f64 / 1e3);
             c.zupt_m.push(g.zupt_um.abs_diff(want.zupt_um) as f64 / 1e6);
             c.toe_off_ms
-                .push(g.toe_off.abs_diff(want.toe_off) as f64 * period_ms);
+                .push(g.events.toe_off.abs_diff(want.events.toe_off) as f64 * period_ms);
             c.heel_strike_ms
-                .push(g.heel_strike.abs_diff(want.heel_strike) as f64 * period_ms);
+                .push(g.events.heel_strike.abs_diff(want.events.heel_strike) as f64 * period_ms);
             c.edges_ms
-                .push(g.heel_off.abs_diff(want.heel_off) as f64 * period_ms);
-            c.edges_ms.push(g.end.abs_diff(want.end) as f64 * period_ms);
+                .push(g.events.heel_off.abs_diff(want.events.heel_off) as f64 * period_ms);
+            c.edges_ms
+                .push(g.events.end.abs_diff(want.events.end) as f64 * period_ms);
         }
         None => c.lost += 1,
     }

@@ -4,37 +4,24 @@
 
 use crate::io::clock::SampleClock;
 use crate::io::datasets::{Reference, Trial};
+use gaitclip::record::stride::{Stride, StrideEvents, StrideFlags};
 
-/// One detected stride, in sample indices of its trial.
+/// One detected stride, in sample indices of its trial: the core's events
+/// ([`gaitclip::record::stride::StrideEvents`]) and whether strides merged.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct Detected {
-    /// Start of the stance before the movement.
-    pub start: u32,
-    /// Heel-off.
-    pub heel_off: u32,
-    /// Toe-off.
-    pub toe_off: u32,
-    /// Heel-strike.
-    pub heel_strike: u32,
-    /// Foot-flat: the movement's end.
-    pub foot_flat: u32,
-    /// The stride's end (the next stride's start).
-    pub end: u32,
-    /// The movement overflowed the movement buffer ([`gaitclip::record::stride::StrideFlags::TOO_LONG`]):
-    /// strides merged.
+    /// The stride's events.
+    pub events: StrideEvents,
+    /// The movement overflowed the movement buffer ([`StrideFlags::TOO_LONG`]): strides
+    /// merged.
     pub too_long: bool,
 }
 
-impl From<&gaitclip::record::stride::Stride> for Detected {
-    fn from(s: &gaitclip::record::stride::Stride) -> Self {
+impl From<&Stride> for Detected {
+    fn from(s: &Stride) -> Self {
         Detected {
-            start: s.start,
-            heel_off: s.heel_off,
-            toe_off: s.toe_off,
-            heel_strike: s.heel_strike,
-            foot_flat: s.foot_flat,
-            end: s.end,
-            too_long: s.flags.0 & gaitclip::record::stride::StrideFlags::TOO_LONG != 0,
+            events: s.events,
+            too_long: s.flags.has(StrideFlags::TOO_LONG),
         }
     }
 }
@@ -44,13 +31,8 @@ impl Detected {
     /// indices across gaps).
     pub fn map(self, f: impl Fn(u32) -> u32) -> Self {
         Detected {
-            start: f(self.start),
-            heel_off: f(self.heel_off),
-            toe_off: f(self.toe_off),
-            heel_strike: f(self.heel_strike),
-            foot_flat: f(self.foot_flat),
-            end: f(self.end),
-            too_long: self.too_long,
+            events: self.events.map(f),
+            ..self
         }
     }
 }
@@ -226,7 +208,7 @@ fn iou(a: (u32, u32), b: (u32, u32)) -> f64 {
 pub fn match_strides(det: &[Detected], refs: &[Reference]) -> Vec<(usize, usize)> {
     let mut cand = Vec::new();
     for (i, d) in det.iter().enumerate() {
-        let dm = (d.heel_off, d.foot_flat);
+        let dm = (d.events.heel_off, d.events.foot_flat);
         for (j, r) in refs.iter().enumerate() {
             let rm = (r.start, r.end);
             let ov = overlap(dm, rm);
@@ -311,7 +293,8 @@ pub fn classify(
     }
     // Mostly inside: at least half the detected movement.
     let mostly_in = |d: &Detected, (a, b): (u32, u32)| {
-        2 * overlap((d.heel_off, d.foot_flat), (a, b)) >= d.foot_flat - d.heel_off
+        2 * overlap((d.events.heel_off, d.events.foot_flat), (a, b))
+            >= d.events.foot_flat - d.events.heel_off
     };
     let uturn = trial
         .unscored_s
@@ -324,8 +307,8 @@ pub fn classify(
     };
     let vicon_moving = |d: &Detected| {
         trial.stance.as_ref().is_some_and(|label| {
-            let from = clock.row_of_number(d.heel_off) as usize;
-            let to = clock.row_of_number(d.foot_flat) as usize;
+            let from = clock.row_of_number(d.events.heel_off) as usize;
+            let to = clock.row_of_number(d.events.foot_flat) as usize;
             let moving = (from..to).filter(|&k| label.get(k) == Some(&false)).count();
             to > from && 2 * moving >= to - from
         })
@@ -350,7 +333,7 @@ pub fn in_span(trial: &Trial, clock: &SampleClock, strides: &[Detected]) -> Vec<
     strides
         .iter()
         .copied()
-        .filter(|d| overlap((d.heel_off, d.foot_flat), span) > 0)
+        .filter(|d| overlap((d.events.heel_off, d.events.foot_flat), span) > 0)
         .collect()
 }
 
@@ -379,7 +362,7 @@ pub fn score(trial: &Trial, run: &Detections) -> Tally {
         let prev = i
             .checked_sub(1)
             .map(|k| det[k])
-            .filter(|p| p.end == d.start);
+            .filter(|p| p.events.end == d.events.start);
         match scored[i] {
             Scored::Unscored => t.unscored += 1,
             Scored::Unbordered => t.unbordered += 1,
@@ -387,13 +370,14 @@ pub fn score(trial: &Trial, run: &Detections) -> Tally {
                 let r = refs[j];
                 t.tp += 1;
                 if let (Some(to), Some(hs)) = (r.toe_off, r.heel_strike) {
-                    t.toe_off_ms.push(ms(d.toe_off as f64 - to as f64));
-                    t.heel_strike_ms.push(ms(d.heel_strike as f64 - hs as f64));
-                    let v = iou((d.toe_off, d.heel_strike), (to, hs));
+                    t.toe_off_ms.push(ms(d.events.toe_off as f64 - to as f64));
+                    t.heel_strike_ms
+                        .push(ms(d.events.heel_strike as f64 - hs as f64));
+                    let v = iou((d.events.toe_off, d.events.heel_strike), (to, hs));
                     phase(&mut t.swing, Some(v));
                 }
                 if let (Some(phs), Some(to)) = (r.prev_heel_strike, r.toe_off) {
-                    let v = prev.map(|p| iou((p.heel_strike, d.toe_off), (phs, to)));
+                    let v = prev.map(|p| iou((p.events.heel_strike, d.events.toe_off), (phs, to)));
                     phase(&mut t.contact, v);
                 }
             }
@@ -429,8 +413,8 @@ pub fn score(trial: &Trial, run: &Detections) -> Tally {
         for d in &det {
             for m in moving
                 .iter_mut()
-                .take(d.foot_flat as usize)
-                .skip(d.heel_off as usize)
+                .take(d.events.foot_flat as usize)
+                .skip(d.events.heel_off as usize)
             {
                 *m = true;
             }
@@ -452,7 +436,7 @@ pub fn score(trial: &Trial, run: &Detections) -> Tally {
         let rows = from..to;
         let instants: Vec<bool> = det
             .iter()
-            .map(|d| clock.row_of_number(d.start) as usize)
+            .map(|d| clock.row_of_number(d.events.start) as usize)
             .filter(|k| rows.contains(k))
             .map(|k| label[k])
             .collect();

@@ -70,7 +70,7 @@ pub fn instants(root: &std::path::Path) -> Result<Vec<Instant>> {
             }
             let Some(len) = r.length_m else { continue };
             let speed = len / ((r.end - r.start) as f64 * dt);
-            let row = p.clock.row_of_number(s.start) as usize;
+            let row = p.clock.row_of_number(s.events.start) as usize;
             if row < 2 || row + 2 >= pos.len() || row >= p.counts.len() {
                 continue;
             }

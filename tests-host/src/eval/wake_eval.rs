@@ -80,10 +80,10 @@ pub fn evaluate_at(dir: &Path, threshold_mg: u32) -> Result<WakeResult> {
         let mut stride_starts = Vec::new();
         let mut rest: Vec<bool> = Vec::with_capacity(counts.len());
         for s in &counts {
-            stride_starts.extend(p.process(s).map(|st| st.start as usize));
+            stride_starts.extend(p.process(s).map(|st| st.events.start as usize));
             rest.push(p.at_rest());
         }
-        stride_starts.extend(std::iter::from_fn(|| p.finish()).map(|st| st.start as usize));
+        stride_starts.extend(std::iter::from_fn(|| p.finish()).map(|st| st.events.start as usize));
         let hz = ds.rate_hz;
         let period =
             ((hz / (f64::from(SLEEP.wake.rate.millihertz()) / 1000.0)).round() as usize).max(1);

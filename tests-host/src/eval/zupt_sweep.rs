@@ -58,8 +58,9 @@ fn errors(
         let holds_two = |r: &datasets::Reference| {
             det.iter().zip(&scored).any(|(d, c)| {
                 *c == Scored::Unbordered
-                    && 2 * (d.foot_flat.min(r.end)).saturating_sub(d.heel_off.max(r.start))
-                        >= d.foot_flat - d.heel_off
+                    && 2 * (d.events.foot_flat.min(r.end))
+                        .saturating_sub(d.events.heel_off.max(r.start))
+                        >= d.events.foot_flat - d.events.heel_off
             })
         };
         for (i, c) in scored.iter().enumerate() {

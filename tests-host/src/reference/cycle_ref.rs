@@ -109,10 +109,10 @@ pub fn zupt_m(run: &CoreRun, k: usize) -> Result<f64, Skipped> {
     let prev = k
         .checked_sub(1)
         .map(|j| &run.strides[j])
-        .filter(|p| p.end == s.start)
+        .filter(|p| p.events.end == s.events.start)
         .ok_or(Skipped::NoPrevious)?;
-    let (i0, i1) = (s.start as usize, s.end as usize);
-    let (low0, low1) = (prev.foot_flat as usize, s.foot_flat as usize);
+    let (i0, i1) = (s.events.start as usize, s.events.end as usize);
+    let (low0, low1) = (prev.events.foot_flat as usize, s.events.foot_flat as usize);
     if i0 - low0 >= 1 << 16 || i1 - low1 >= 1 << 16 {
         return Err(Skipped::LongRest);
     }

@@ -30,7 +30,7 @@ pub fn features(stride: &Stride, stats: &StrideStats, rate: SampleRate) -> [f64;
             hz / s.samples as f64
         };
     }
-    let period = stride.end.wrapping_sub(stride.start);
+    let period = stride.events.end.wrapping_sub(stride.events.start);
     f[STRIDE_FREQUENCY] = if period == 0 { 0.0 } else { hz / period as f64 };
     f[ZUPT_LENGTH] = stride.zupt_um as f64 / 1e6;
     f

@@ -25,6 +25,7 @@ use nalgebra::{Matrix3, SymmetricEigen, Vector3};
 
 use crate::eval::matching::Detected;
 use crate::io::trace::G_MPS2;
+use gaitclip::record::stride::StrideEvents;
 
 /// Runs the reference over raw counts; strides in the order the core reports them.
 pub fn strides(samples: &[RawSample], config: Config) -> Vec<Detected> {
@@ -401,12 +402,14 @@ impl Tracker {
                     self.stance_start
                 };
                 let d = Detected {
-                    start: start as u32,
-                    heel_off: self.heel_off as u32,
-                    toe_off: (self.heel_off + to) as u32,
-                    heel_strike: (self.heel_off + hs) as u32,
-                    foot_flat: at as u32,
-                    end: at as u32,
+                    events: StrideEvents {
+                        start: start as u32,
+                        heel_off: self.heel_off as u32,
+                        toe_off: (self.heel_off + to) as u32,
+                        heel_strike: (self.heel_off + hs) as u32,
+                        foot_flat: at as u32,
+                        end: at as u32,
+                    },
                     too_long: false,
                 };
                 self.stance_start = at;

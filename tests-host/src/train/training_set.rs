@@ -70,7 +70,7 @@ pub fn run_dataset(dataset: &Dataset) -> Result<Vec<TrialRun>> {
             // A stride belongs to the span when its movement's middle does: a first step
             // that ends just inside the reference's first stride is not in it.
             .filter(|(s, _)| {
-                let mid = s.heel_off / 2 + s.end / 2;
+                let mid = s.events.heel_off / 2 + s.events.end / 2;
                 mid >= span.0 && mid < span.1
             })
             .unzip();
@@ -81,8 +81,9 @@ pub fn run_dataset(dataset: &Dataset) -> Result<Vec<TrialRun>> {
         let holds_two = |r: &datasets::Reference| {
             det.iter().zip(&scored).any(|(d, c)| {
                 *c == matching::Scored::Unbordered
-                    && 2 * (d.foot_flat.min(r.end)).saturating_sub(d.heel_off.max(r.start))
-                        >= d.foot_flat - d.heel_off
+                    && 2 * (d.events.foot_flat.min(r.end))
+                        .saturating_sub(d.events.heel_off.max(r.start))
+                        >= d.events.foot_flat - d.events.heel_off
             })
         };
         let mut reference = vec![None; strides.len()];
