@@ -22,6 +22,8 @@ use gaitclip::mpu6050::WakeRate;
 use gaitclip_board::live_settings::{FIFO_BATCH, RATE_HZ};
 use gaitclip_board::sleep::SLEEP;
 
+use crate::eval::markdown::{Column, Table};
+
 /// A current from a datasheet, µA.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Cited {
@@ -349,7 +351,11 @@ pub fn report(m4_insn: f64, m0_insn: f64) -> String {
     );
     for b in &boards {
         let _ = writeln!(o, "**{}**\n", b.board);
-        let _ = writeln!(o, "| part | walking µA | still µA |\n|---|---:|---:|");
+        let mut parts = Table::new([
+            Column::from("part"),
+            Column::right("walking µA"),
+            Column::right("still µA"),
+        ]);
         let mut names: Vec<&str> = b.walking.iter().map(|p| p.0).collect();
         for p in &b.still {
             if !names.contains(&p.0) {
@@ -363,55 +369,66 @@ pub fn report(m4_insn: f64, m0_insn: f64) -> String {
                     .find(|p| p.0 == n)
                     .map_or(String::new(), |p| format!("{:.1}", p.1))
             };
-            let _ = writeln!(o, "| {n} | {} | {} |", cell(&b.walking), cell(&b.still));
+            parts.row([n.to_string(), cell(&b.walking), cell(&b.still)]);
         }
         let still_ok = if b.still_ua() <= 30.0 {
             "≤ 30 µA: met"
         } else {
             "**over the 30 µA target**"
         };
-        let _ = writeln!(
-            o,
-            "| **total** | **{:.0}** | **{:.1}** ({still_ok}) |\n",
-            b.walking_ua(),
-            b.still_ua()
-        );
+        parts.row([
+            "**total**".to_string(),
+            format!("**{:.0}**", b.walking_ua()),
+            format!("**{:.1}** ({still_ok})", b.still_ua()),
+        ]);
+        let _ = writeln!(o, "{}", parts.render());
         for n in &b.notes {
             let _ = writeln!(o, "- {n}");
         }
         let _ = writeln!(o);
     }
-    let _ = writeln!(
-        o,
-        "| board | battery | hours walking | days still | days of use, 1 h walking a day |\n|---|---|---:|---:|---:|"
-    );
+    let mut life = Table::new([
+        Column::from("board"),
+        Column::from("battery"),
+        Column::right("hours walking"),
+        Column::right("days still"),
+        Column::right("days of use, 1 h walking a day"),
+    ]);
     for b in &boards {
         for (name, mah) in BATTERIES {
-            let _ = writeln!(
-                o,
-                "| {} | {name} | {:.0} | {:.1} | {:.1} |",
-                b.board,
-                b.walking_hours(mah),
-                b.standby_days(mah),
-                b.days_of_use(mah, 1.0)
-            );
+            life.row([
+                b.board.to_string(),
+                name.to_string(),
+                format!("{:.0}", b.walking_hours(mah)),
+                format!("{:.1}", b.standby_days(mah)),
+                format!("{:.1}", b.days_of_use(mah, 1.0)),
+            ]);
         }
     }
+    o.push_str(&life.render());
     let _ = writeln!(
         o,
         "\nA CR2032's 225 mAh is rated at a light drain; at the 4 mA of walking its usable capacity is lower (not modelled).\n"
     );
     let _ = writeln!(
         o,
-        "What MCU-side changes give on the nRF52840 (days of use on a CR2032 at 1 h of walking a day):\n\n| change | days before | days after | change |\n|---|---:|---:|---:|"
+        "What MCU-side changes give on the nRF52840 (days of use on a CR2032 at 1 h of walking a day):\n"
     );
+    let mut changes = Table::new([
+        Column::from("change"),
+        Column::right("days before"),
+        Column::right("days after"),
+        Column::right("change"),
+    ]);
     for s in savings(m4_insn) {
-        let _ = writeln!(
-            o,
-            "| {} | {:.1} | {:.1} | {:+.1} % |",
-            s.what, s.days.0, s.days.1, s.days.2
-        );
+        changes.row([
+            s.what.clone(),
+            format!("{:.1}", s.days.0),
+            format!("{:.1}", s.days.1),
+            format!("{:+.1} %", s.days.2),
+        ]);
     }
+    o.push_str(&changes.render());
     let _ = writeln!(o, "\nSources:\n");
     let mut cited = vec![
         MPU6050_SAMPLING,

@@ -23,6 +23,7 @@ use gaitclip::pipeline::detectors::Detector;
 use crate::cost::firmware::build_for;
 use crate::cost::insn_count::{run_bench, run_bench_peak_valley, InsnReport, Stat, StepInsnReport};
 use crate::cost::qemu::{self, RunOptions};
+use crate::eval::markdown::{Column, Table};
 
 /// Flash and static RAM of a firmware ELF, bytes.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -343,10 +344,42 @@ fn verdict(ok: bool) -> &'static str {
     }
 }
 
+/// The columns of an instruction table.
+fn insn_table() -> Table {
+    Table::new([
+        Column::from("step"),
+        Column::right("M4 mean"),
+        Column::right("M4 max"),
+        Column::right("M0 mean"),
+        Column::right("M0 max"),
+    ])
+}
+
+/// An instruction row: `step`, then the M4 and M0 mean and max.
+fn insn_row(t: &mut Table, step: impl Into<String>, m4: &Stat, m0: &Stat) {
+    t.row([
+        step.into(),
+        format!("{:.0}", m4.mean),
+        m4.max.to_string(),
+        format!("{:.0}", m0.mean),
+        m0.max.to_string(),
+    ]);
+}
+
+/// The row of the mean over all samples, strides spread over them (no max).
+fn insn_all_row(t: &mut Table, step: &str, m4_mean: f64, m0_mean: f64) {
+    t.row([
+        step.to_string(),
+        format!("{m4_mean:.0}"),
+        String::new(),
+        format!("{m0_mean:.0}"),
+        String::new(),
+    ]);
+}
+
 fn render(r: &Report) -> String {
     let mut o = String::new();
     let (m4, m0) = (&r.insns[0], &r.insns[1]);
-    let f = |s: &Stat| format!("{:.0} | {}", s.mean, s.max);
     let _ = writeln!(o, "### Instructions\n");
     let _ = writeln!(
         o,
@@ -355,67 +388,64 @@ fn render(r: &Report) -> String {
          leaves out the per-stride steps, listed below it.\n",
         r.trace
     );
-    let _ = writeln!(
-        o,
-        "| step | M4 mean | M4 max | M0 mean | M0 max |\n|---|---:|---:|---:|---:|"
+    let mut cycle = insn_table();
+    insn_row(
+        &mut cycle,
+        "per sample: sample path",
+        &m4.sample,
+        &m0.sample,
     );
-    let _ = writeln!(
-        o,
-        "| per sample: sample path | {} | {} |",
-        f(&m4.sample),
-        f(&m0.sample)
+    insn_all_row(
+        &mut cycle,
+        "per sample: all work, strides spread over the samples",
+        m4.sample_all_mean,
+        m0.sample_all_mean,
     );
-    let _ = writeln!(
-        o,
-        "| per sample: all work, strides spread over the samples | {:.0} | | {:.0} | |",
-        m4.sample_all_mean, m0.sample_all_mean
+    insn_row(
+        &mut cycle,
+        format!(
+            "per stride: pipeline, default model (`{}`)",
+            m4.default_model
+        ),
+        &m4.stride,
+        &m0.stride,
     );
-    let _ = writeln!(
-        o,
-        "| per stride: pipeline, default model (`{}`) | {} | {} |",
-        m4.default_model,
-        f(&m4.stride),
-        f(&m0.stride)
-    );
-    let _ = writeln!(
-        o,
-        "| · phases, statistics, ZUPT (`CycleDetector::close`) | {} | {} |",
-        f(&m4.close),
-        f(&m0.close)
-    );
-    let _ = writeln!(
-        o,
-        "| · · phase split (`phases::split`) | {} | {} |",
-        f(&m4.split),
-        f(&m0.split)
-    );
-    let _ = writeln!(
-        o,
-        "| · · phase statistics (`StrideStats::measure`) | {} | {} |",
-        f(&m4.stats),
-        f(&m0.stats)
-    );
-    let _ = writeln!(
-        o,
-        "| · features and default model (`LengthChain::measure`) | {} | {} |",
-        f(&m4.measure),
-        f(&m0.measure)
-    );
-    let _ = writeln!(
-        o,
-        "| features (`Features::of`) | {} | {} |",
-        f(&m4.features),
-        f(&m0.features)
-    );
-    for (name, s) in &m4.models {
-        let m0s = m0.models.iter().find(|(n, _)| n == name).map(|(_, s)| f(s));
-        let _ = writeln!(
-            o,
-            "| model `{name}` | {} | {} |",
-            f(s),
-            m0s.unwrap_or_else(|| "not in the M0 build | ".into())
-        );
+    for (step, a, b) in [
+        (
+            "· phases, statistics, ZUPT (`CycleDetector::close`)",
+            &m4.close,
+            &m0.close,
+        ),
+        ("· · phase split (`phases::split`)", &m4.split, &m0.split),
+        (
+            "· · phase statistics (`StrideStats::measure`)",
+            &m4.stats,
+            &m0.stats,
+        ),
+        (
+            "· features and default model (`LengthChain::measure`)",
+            &m4.measure,
+            &m0.measure,
+        ),
+        ("features (`Features::of`)", &m4.features, &m0.features),
+    ] {
+        insn_row(&mut cycle, step, a, b);
     }
+    for (name, s) in &m4.models {
+        match m0.models.iter().find(|(n, _)| n == name) {
+            Some((_, m0s)) => insn_row(&mut cycle, format!("model `{name}`"), s, m0s),
+            None => {
+                cycle.row([
+                    format!("model `{name}`"),
+                    format!("{:.0}", s.mean),
+                    s.max.to_string(),
+                    "not in the M0 build".to_string(),
+                    String::new(),
+                ]);
+            }
+        }
+    }
+    o.push_str(&cycle.render());
     let (l4, l0) = (&r.lu_insns[0], &r.lu_insns[1]);
     let _ = writeln!(
         o,
@@ -423,27 +453,26 @@ fn render(r: &Report) -> String {
          the same trace ({} steps, as the host replay finds them):\n",
         l4.steps
     );
-    let _ = writeln!(
-        o,
-        "| step | M4 mean | M4 max | M0 mean | M0 max |\n|---|---:|---:|---:|---:|"
+    let mut lu = insn_table();
+    insn_row(
+        &mut lu,
+        "per sample: sample path (low-pass, peak-valley rules)",
+        &l4.sample,
+        &l0.sample,
     );
-    let _ = writeln!(
-        o,
-        "| per sample: sample path (low-pass, peak-valley rules) | {} | {} |",
-        f(&l4.sample),
-        f(&l0.sample)
+    insn_all_row(
+        &mut lu,
+        "per sample: all work, steps spread over the samples",
+        l4.sample_all_mean,
+        l0.sample_all_mean,
     );
-    let _ = writeln!(
-        o,
-        "| per sample: all work, steps spread over the samples | {:.0} | | {:.0} | |",
-        l4.sample_all_mean, l0.sample_all_mean
+    insn_row(
+        &mut lu,
+        "per step: Lu's chain (`lu::lu_chain_um`)",
+        &l4.step,
+        &l0.step,
     );
-    let _ = writeln!(
-        o,
-        "| per step: Lu's chain (`lu::lu_chain_um`) | {} | {} |",
-        f(&l4.step),
-        f(&l0.step)
-    );
+    o.push_str(&lu.render());
     let _ = writeln!(o, "\n### Size\n");
     let _ = writeln!(
         o,
@@ -451,17 +480,25 @@ fn render(r: &Report) -> String {
          contents; static RAM: allocated sections in RAM; stack: high-water mark of the \
          painted stack after replaying the demo walk in QEMU.\n"
     );
-    let _ = writeln!(
-        o,
-        "| build | flash (B) | static RAM (B) | stack used / region (B) |\n|---|---:|---:|---:|"
-    );
+    let mut sizes = Table::new([
+        Column::from("build"),
+        Column::right("flash (B)"),
+        Column::right("static RAM (B)"),
+        Column::right("stack used / region (B)"),
+    ]);
     for (label, s, stack) in &r.sizes {
         let st = match stack {
             Some((u, n)) => format!("{u} / {n}"),
             None => "not run (no board here)".into(),
         };
-        let _ = writeln!(o, "| {label} | {} | {} | {st} |", s.flash, s.static_ram);
+        sizes.row([
+            label.to_string(),
+            s.flash.to_string(),
+            s.static_ram.to_string(),
+            st,
+        ]);
     }
+    o.push_str(&sizes.render());
     let _ = writeln!(
         o,
         "\nThe boards without an emulator paint their stack too where they can: the Bluetooth \
@@ -471,59 +508,74 @@ fn render(r: &Report) -> String {
          statics)."
     );
     let _ = writeln!(o, "\n### Host replay\n");
-    let _ = writeln!(
-        o,
-        "| pipeline on {} | samples/s |\n|---|---:|\n| gaitclip `replay` (criterion mean) | {:.0} |\n| gaitmap 2.6.0 MAD pipeline (median of {} runs after a first of {:.2} s) | {:.0} |\n| ratio | {:.0}× |",
-        r.trace,
-        r.host_rate,
-        r.gaitmap["runs"].as_u64().unwrap_or(0),
-        r.gaitmap["first_run_s"].as_f64().unwrap_or(f64::NAN),
-        r.gaitmap_rate,
-        r.host_rate / r.gaitmap_rate
-    );
+    let mut host = Table::new([
+        Column::from(format!("pipeline on {}", r.trace)),
+        Column::right("samples/s"),
+    ]);
+    host.row([
+        "gaitclip `replay` (criterion mean)".to_string(),
+        format!("{:.0}", r.host_rate),
+    ]);
+    host.row([
+        format!(
+            "gaitmap 2.6.0 MAD pipeline (median of {} runs after a first of {:.2} s)",
+            r.gaitmap["runs"].as_u64().unwrap_or(0),
+            r.gaitmap["first_run_s"].as_f64().unwrap_or(f64::NAN)
+        ),
+        format!("{:.0}", r.gaitmap_rate),
+    ]);
+    host.row([
+        "ratio".to_string(),
+        format!("{:.0}×", r.host_rate / r.gaitmap_rate),
+    ]);
+    o.push_str(&host.render());
     let nrf = r
         .sizes
         .iter()
         .find(|(l, _, _)| l.starts_with("nrf52840-dk"));
-    let _ = writeln!(o, "\n### Goals\n\n| goal | measured | |\n|---|---:|---|");
-    let _ = writeln!(
-        o,
-        "| ≤ 150 instructions per sample on M4 (mean) | {:.0} | {} |",
-        m4.sample.mean,
-        verdict(m4.sample.mean <= 150.0)
+    let _ = writeln!(o, "\n### Goals\n");
+    let mut goals = Table::new([
+        Column::from("goal"),
+        Column::right("measured"),
+        Column::from(""),
+    ]);
+    let mut goal = |what: &str, measured: String, ok: bool| {
+        goals.row([what.to_string(), measured, verdict(ok).to_string()]);
+    };
+    goal(
+        "≤ 150 instructions per sample on M4 (mean)",
+        format!("{:.0}", m4.sample.mean),
+        m4.sample.mean <= 150.0,
     );
-    let _ = writeln!(
-        o,
-        "| ≤ 400 instructions per sample on M0 (mean) | {:.0} | {} |",
-        m0.sample.mean,
-        verdict(m0.sample.mean <= 400.0)
+    goal(
+        "≤ 400 instructions per sample on M0 (mean)",
+        format!("{:.0}", m0.sample.mean),
+        m0.sample.mean <= 400.0,
     );
-    let _ = writeln!(
-        o,
-        "| ≤ 30 000 instructions per stride, default model (M4 mean) | {:.0} | {} |",
-        m4.stride.mean,
-        verdict(m4.stride.mean <= 30_000.0)
+    goal(
+        "≤ 30 000 instructions per stride, default model (M4 mean)",
+        format!("{:.0}", m4.stride.mean),
+        m4.stride.mean <= 30_000.0,
     );
     if let Some((_, s, _)) = nrf {
-        let _ = writeln!(
-            o,
-            "| nRF52840 flash ≤ 48 KiB (49 152 B) | {} | {} |",
-            s.flash,
-            verdict(s.flash <= 49_152)
+        goal(
+            "nRF52840 flash ≤ 48 KiB (49 152 B)",
+            s.flash.to_string(),
+            s.flash <= 49_152,
         );
-        let _ = writeln!(
-            o,
-            "| nRF52840 static RAM ≤ 12 KiB (12 288 B) | {} | {} |",
-            s.static_ram,
-            verdict(s.static_ram <= 12_288)
+        goal(
+            "nRF52840 static RAM ≤ 12 KiB (12 288 B)",
+            s.static_ram.to_string(),
+            s.static_ram <= 12_288,
         );
     }
     let ratio = r.host_rate / r.gaitmap_rate;
-    let _ = writeln!(
-        o,
-        "| host replay ≥ 100× gaitmap | {ratio:.0}× | {} |",
-        verdict(ratio >= 100.0)
+    goal(
+        "host replay ≥ 100× gaitmap",
+        format!("{ratio:.0}×"),
+        ratio >= 100.0,
     );
+    o.push_str(&goals.render());
     let _ = writeln!(o, "\n### Energy\n");
     o.push_str(&crate::cost::energy::report(
         m4.sample_all_mean,

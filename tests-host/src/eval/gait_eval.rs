@@ -29,6 +29,7 @@ use anyhow::Result;
 use gaitclip::record::gait::Gait;
 use gaitclip::record::stride::Stride;
 
+use crate::eval::markdown::{Column, Table};
 use crate::eval::matching::{classify, Detected, Scored};
 use crate::eval::stats::{abs_quantile, median};
 use crate::io::csv_trace;
@@ -272,17 +273,25 @@ pub fn table(results: &[(String, GaitResult)]) -> String {
             e.2.push(c.reference);
         }
     }
-    let mut s = String::new();
-    s.push_str("| parameter | dataset | pace | strides | reference (median) | ours (median) | bias | median \\|error\\| | p95 \\|error\\| |\n");
-    s.push_str("|---|---|---|---:|---:|---:|---:|---:|---:|\n");
+    let mut t = Table::new([
+        Column::from("parameter"),
+        Column::from("dataset"),
+        Column::from("pace"),
+        Column::right("strides"),
+        Column::right("reference (median)"),
+        Column::right("ours (median)"),
+        Column::right("bias"),
+        Column::right("median |error|"),
+        Column::right("p95 |error|"),
+    ]);
     for ((_, p, d, pace), (unit, err, refs, ours)) in &groups {
+        let head = [format!("{p} ({unit})"), d.to_string(), pace.to_string()];
         if err.is_empty() {
-            let _ = writeln!(
-                s,
-                "| {p} ({unit}) | {d} | {pace} | {} | — | {:.1} | — | — | — |",
-                ours.len(),
-                median(ours)
-            );
+            let mut r = head.to_vec();
+            r.extend([ours.len().to_string(), "—".into()]);
+            r.push(format!("{:.1}", median(ours)));
+            r.extend(["—".to_string(), "—".into(), "—".into()]);
+            t.row(r);
             continue;
         }
         let f = |v: f64| {
@@ -292,47 +301,57 @@ pub fn table(results: &[(String, GaitResult)]) -> String {
                 format!("{v:.1}")
             }
         };
-        let _ = writeln!(
-            s,
-            "| {p} ({unit}) | {d} | {pace} | {} | {} | {} | {} | {} | {} |",
-            err.len(),
+        let mut r = head.to_vec();
+        r.extend([
+            err.len().to_string(),
             f(median(refs)),
             f(median(ours)),
             f(median(err)),
             f(abs_quantile(err, 0.5)),
             f(abs_quantile(err, 0.95)),
-        );
+        ]);
+        t.row(r);
     }
+    let mut s = t.render();
     let skipped: usize = results.iter().map(|r| r.1.not_a_cycle).sum();
     let _ = writeln!(
         s,
         "\nTimes over strides the core reports as one gait cycle: {skipped} matched strides it marks `unknown` (from or into a rest, across a gap) are left out.\n"
     );
-    s.push_str("| U-turn: \\|Σ turning_angle\\| of a trial's strides | trials | median | median \\|error\\| vs 180° | p95 \\|error\\| |\n");
-    s.push_str("|---|---:|---:|---:|---:|\n");
+    let mut t = Table::new([
+        Column::from("U-turn: |Σ turning_angle| of a trial's strides"),
+        Column::right("trials"),
+        Column::right("median"),
+        Column::right("median |error| vs 180°"),
+        Column::right("p95 |error|"),
+    ]);
     for (name, r) in results {
         if r.trial_turns.is_empty() {
             continue;
         }
         let turns: Vec<f64> = r.trial_turns.iter().map(|t| t.1).collect();
         let err: Vec<f64> = turns.iter().map(|t| t - 180.0).collect();
-        let _ = writeln!(
-            s,
-            "| {name} | {} | {:.1}° | {:.1}° | {:.1}° |",
-            turns.len(),
-            median(&turns),
-            abs_quantile(&err, 0.5),
-            abs_quantile(&err, 0.95)
-        );
+        t.row([
+            name.to_string(),
+            turns.len().to_string(),
+            format!("{:.1}°", median(&turns)),
+            format!("{:.1}°", abs_quantile(&err, 0.5)),
+            format!("{:.1}°", abs_quantile(&err, 0.95)),
+        ]);
     }
+    s.push_str(&t.render());
     for (name, r) in results {
         if r.status.is_empty() {
             continue;
         }
-        let _ = write!(
-            s,
-            "\n| {name}: Vicon speed | strides | walking | running | unknown | correct |\n|---|---:|---:|---:|---:|---:|\n"
-        );
+        let mut t = Table::new([
+            Column::from(format!("{name}: Vicon speed")),
+            Column::right("strides"),
+            Column::right("walking"),
+            Column::right("running"),
+            Column::right("unknown"),
+            Column::right("correct"),
+        ]);
         for class in ["walking", "fast", "running"] {
             let n = |g: Gait| r.status.get(&(class, g.name())).copied().unwrap_or(0);
             let (w, ru, u) = (n(Gait::Walking), n(Gait::Running), n(Gait::Unknown));
@@ -348,11 +367,17 @@ pub fn table(results: &[(String, GaitResult)]) -> String {
                 ),
                 _ => ("1.5–2.5 m/s", "(no reference)".to_string()),
             };
-            let _ = writeln!(
-                s,
-                "| {bound} ({class}) | {total} | {w} | {ru} | {u} | {correct} |"
-            );
+            t.row([
+                format!("{bound} ({class})"),
+                total.to_string(),
+                w.to_string(),
+                ru.to_string(),
+                u.to_string(),
+                correct,
+            ]);
         }
+        s.push('\n');
+        s.push_str(&t.render());
     }
     s
 }

@@ -34,6 +34,7 @@ use gaitclip::pipeline::config::{Config, FILL_MAX_MS};
 use gaitclip::record::stride::{Stride, StrideFlags};
 use gaitclip::sensor::sample::RawSample;
 
+use crate::eval::markdown::{Column, Table};
 use crate::eval::matching::{self, Detected};
 use crate::io::clock::Gap;
 use crate::io::datasets;
@@ -366,9 +367,19 @@ pub fn limit_ms(sweeps: &[(f64, Vec<(Pattern, Cost)>)]) -> f64 {
 
 /// The Markdown table of one sweep.
 pub fn table(title: &str, period_ms: f64, sweep: &[(Pattern, Cost)]) -> String {
-    let mut s = format!(
-        "{title}\n\n| hole (samples) | hole (ms) | strides cut per pattern | mean \\|Δ length\\| mm: single stance / single swing / cluster stance / cluster swing | p95 \\|Δ length\\| mm, worst pattern | mean \\|Δ ZUPT\\| mm, worst pattern | \\|Δ toe-off\\| / \\|Δ heel-strike\\| ms, swing holes, median / p95 | \\|Δ heel-off\\|, \\|Δ foot-flat\\| ms, p95, worst pattern | lost (missed or split) / invalid |\n|---:|---:|---:|---|---:|---:|---|---:|---:|\n"
-    );
+    let mut table = Table::new([
+        Column::right("hole (samples)"),
+        Column::right("hole (ms)"),
+        Column::right("strides cut per pattern"),
+        Column::from(
+            "mean |Δ length| mm: single stance / single swing / cluster stance / cluster swing",
+        ),
+        Column::right("p95 |Δ length| mm, worst pattern"),
+        Column::right("mean |Δ ZUPT| mm, worst pattern"),
+        Column::from("|Δ toe-off| / |Δ heel-strike| ms, swing holes, median / p95"),
+        Column::right("|Δ heel-off|, |Δ foot-flat| ms, p95, worst pattern"),
+        Column::right("lost (missed or split) / invalid"),
+    ]);
     let lens: Vec<u32> = {
         let mut l: Vec<u32> = sweep.iter().map(|(p, _)| p.len).collect();
         l.dedup();
@@ -413,20 +424,25 @@ pub fn table(title: &str, period_ms: f64, sweep: &[(Pattern, Cost)]) -> String {
             .iter()
             .map(|c| quantile(&c.edges_ms, 0.95))
             .fold(0.0f64, f64::max);
-        let _ = writeln!(
-            s,
-            "| {len} | {:.0} | {cut} | {} | {:.1} | {:.1} | {:.0} / {:.0}, {:.0} / {:.0} | {edges:.0} | {lost} / {invalid} |",
-            len as f64 * period_ms,
+        table.row([
+            len.to_string(),
+            format!("{:.0}", len as f64 * period_ms),
+            cut.to_string(),
             means.join(" / "),
-            p95 * 1e3,
-            zupt * 1e3,
-            quantile(&to, 0.5),
-            quantile(&to, 0.95),
-            quantile(&hs, 0.5),
-            quantile(&hs, 0.95),
-        );
+            format!("{:.1}", p95 * 1e3),
+            format!("{:.1}", zupt * 1e3),
+            format!(
+                "{:.0} / {:.0}, {:.0} / {:.0}",
+                quantile(&to, 0.5),
+                quantile(&to, 0.95),
+                quantile(&hs, 0.5),
+                quantile(&hs, 0.95)
+            ),
+            format!("{edges:.0}"),
+            format!("{lost} / {invalid}"),
+        ]);
     }
-    s
+    format!("{title}\n\n{}", table.render())
 }
 
 /// The whole report: both rates' tables and the limit they give.

@@ -26,11 +26,11 @@
 //! worst).
 
 use std::collections::BTreeMap;
-use std::fmt::Write as _;
 
 use anyhow::Result;
 use gaitclip::length::models::{self, Model, ModelParams, MODELS};
 
+use crate::eval::markdown::{Column, Table};
 use crate::eval::plot::{Plot, COLOURS};
 use crate::eval::stats::median;
 use crate::train::cross_validation;
@@ -321,49 +321,42 @@ pub fn score(runs: &[TrialRun], pred: &Predictions) -> Vec<DatasetScores> {
 /// The Markdown table: one row per model, per dataset RMSE / MAE / bias in cm and the
 /// walked-distance error (median / worst trial, %).
 pub fn table(scores: &[DatasetScores]) -> String {
-    let mut s = String::from("| model |");
-    let mut rule = String::from("|---|");
+    let mut header = vec!["model".to_string()];
     for (d, sc) in scores {
         let n = sc[0].strides;
         if n > 0 {
-            let _ = write!(s, " {d}: RMSE / MAE / bias, cm ({n} strides) |");
-            rule.push_str("---|");
+            header.push(format!("{d}: RMSE / MAE / bias, cm ({n} strides)"));
         }
-        let _ = write!(
-            s,
-            " {d}: distance error, median / worst of {} trials |",
+        header.push(format!(
+            "{d}: distance error, median / worst of {} trials",
             sc[0].distance.len()
-        );
-        rule.push_str("---|");
+        ));
     }
-    s.push('\n');
-    s.push_str(&rule);
-    s.push('\n');
+    let mut t = Table::new(header);
     for m in Model::ALL {
         let k = m as usize;
-        let _ = write!(s, "| `{}` |", m.name());
+        let mut r = vec![format!("`{}`", m.name())];
         for (_, sc) in scores {
             let x = &sc[k];
             if x.strides > 0 {
-                let _ = write!(
-                    s,
-                    " {:.1} / {:.1} / {:+.1} |",
+                r.push(format!(
+                    "{:.1} / {:.1} / {:+.1}",
                     x.rmse() * 100.0,
                     x.mae() * 100.0,
                     x.bias() * 100.0
-                );
+                ));
             }
-            let worst = x.distance.iter().cloned().fold(0.0, f64::max);
-            let _ = write!(
-                s,
-                " {:.1} % / {:.1} % |",
-                median(&x.distance) * 100.0,
-                worst * 100.0
-            );
+            r.push(distance_cell(&x.distance));
         }
-        s.push('\n');
+        t.row(r);
     }
-    s
+    t.render()
+}
+
+/// `median % / worst %` of walked-distance errors (fractions).
+fn distance_cell(distance: &[f64]) -> String {
+    let worst = distance.iter().cloned().fold(0.0, f64::max);
+    format!("{:.1} % / {:.1} %", median(distance) * 100.0, worst * 100.0)
 }
 
 /// Every model's RMSE and bias (cm) per dataset three ways: one row per model, a column
@@ -373,43 +366,37 @@ pub fn three_ways_table(by: &[(Validation, Vec<DatasetScores>)]) -> String {
     let Some((_, first)) = by.first() else {
         return String::new();
     };
-    let mut s = String::from("| model |");
-    let mut rule = String::from("|---|");
+    let mut header = vec!["model".to_string()];
     for (d, sc) in first {
         for (v, _) in by {
             if sc[0].strides > 0 {
-                let _ = write!(s, " {d}, {}: RMSE / bias cm |", v.name());
+                header.push(format!("{d}, {}: RMSE / bias cm", v.name()));
             } else {
-                let _ = write!(s, " {d}, {}: distance error median / worst |", v.name());
+                header.push(format!("{d}, {}: distance error median / worst", v.name()));
             }
-            rule.push_str("---|");
         }
     }
-    s.push('\n');
-    s.push_str(&rule);
-    s.push('\n');
+    let mut t = Table::new(header);
     for m in Model::ALL {
         let k = m as usize;
-        let _ = write!(s, "| `{}` |", m.name());
+        let mut r = vec![format!("`{}`", m.name())];
         for (i, (_, sc)) in first.iter().enumerate() {
             for (_, scores) in by {
                 let x = &scores[i].1[k];
                 if sc[0].strides > 0 {
-                    let _ = write!(s, " {:.1} / {:+.1} |", x.rmse() * 100.0, x.bias() * 100.0);
+                    r.push(format!(
+                        "{:.1} / {:+.1}",
+                        x.rmse() * 100.0,
+                        x.bias() * 100.0
+                    ));
                 } else {
-                    let worst = x.distance.iter().cloned().fold(0.0, f64::max);
-                    let _ = write!(
-                        s,
-                        " {:.1} % / {:.1} % |",
-                        median(&x.distance) * 100.0,
-                        worst * 100.0
-                    );
+                    r.push(distance_cell(&x.distance));
                 }
             }
         }
-        s.push('\n');
+        t.row(r);
     }
-    s
+    t.render()
 }
 
 /// RMSE / bias (cm) per speed or length bin, one row per model, a column per dataset (with
@@ -433,61 +420,61 @@ pub fn binned_table(scores: &[DatasetScores], by: BinBy) -> String {
         }
     };
     let with: Vec<&DatasetScores> = scores.iter().filter(|(_, s)| s[0].strides > 0).collect();
-    let mut s = String::from("| model |");
-    let mut rule = String::from("|---|");
+    let mut header = vec!["model".to_string()];
     for (d, sc) in &with {
         for b in bins {
-            let _ = write!(s, " {d} {} ({}) |", label(b), sc[0].bin(by, *b).strides);
-            rule.push_str("---|");
+            header.push(format!("{d} {} ({})", label(b), sc[0].bin(by, *b).strides));
         }
     }
-    s.push('\n');
-    s.push_str(&rule);
-    s.push('\n');
+    let mut t = Table::new(header);
     for m in Model::ALL {
-        let _ = write!(s, "| `{}` |", m.name());
+        let mut r = vec![format!("`{}`", m.name())];
         for (_, sc) in &with {
             for b in bins {
                 let x = sc[m as usize].bin(by, *b);
                 if x.strides == 0 {
-                    s.push_str(" – |");
+                    r.push("–".into());
                 } else {
-                    let _ = write!(
-                        s,
-                        " {:.1} / {:+.1} / {:.1} % |",
+                    r.push(format!(
+                        "{:.1} / {:+.1} / {:.1} %",
                         x.rmse() * 100.0,
                         x.bias() * 100.0,
                         x.pooled_distance_error() * 100.0
-                    );
+                    ));
                 }
             }
         }
-        s.push('\n');
+        t.row(r);
     }
-    s
+    t.render()
 }
 
 /// Walked distance per trial by `model`: one row per trial whose walked distance is known
 /// ([`TrialRun::reference_total_m`]), with the reference and the error.
 pub fn walked_table(runs: &[TrialRun], pred: &Predictions, model: Model) -> String {
-    let mut s = String::from(
-        "| dataset | trial | strides | walked (m) | reference (m) | error |\n|---|---|---:|---:|---:|---:|\n",
-    );
+    let mut t = Table::new([
+        Column::from("dataset"),
+        Column::from("trial"),
+        Column::right("strides"),
+        Column::right("walked (m)"),
+        Column::right("reference (m)"),
+        Column::right("error"),
+    ]);
     for (run, p) in runs.iter().zip(pred) {
         let Some(total) = run.reference_total_m else {
             continue;
         };
         let sum: f64 = p.iter().map(|p| p[model as usize]).sum();
-        let _ = writeln!(
-            s,
-            "| {} | {} | {} | {sum:.2} | {total:.2} | {:+.1} % |",
-            run.dataset,
-            run.trial,
-            p.len(),
-            (sum - total) / total * 100.0
-        );
+        t.row([
+            run.dataset.to_string(),
+            run.trial.to_string(),
+            p.len().to_string(),
+            format!("{sum:.2}"),
+            format!("{total:.2}"),
+            format!("{:+.1} %", (sum - total) / total * 100.0),
+        ]);
     }
-    s
+    t.render()
 }
 
 /// Stride-length error of `model` against the reference stride's speed, one colour per

@@ -3,16 +3,64 @@
 
 use std::fmt::Write as _;
 
-/// A Markdown table: a header row and rows of cells, rendered with `|` separators.
+/// How a column's cells line up: the separator row's `---` (left, Markdown's default) or
+/// `---:` (right, for numbers).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum Align {
+    /// `---`.
+    #[default]
+    Left,
+    /// `---:`.
+    Right,
+}
+
+/// A column of a [`Table`]: its name and alignment. A `&str` or `String` is a left-aligned
+/// column; [`Column::right`] makes a numeric one.
+#[derive(Clone, Debug, Default, PartialEq, Eq)]
+pub struct Column {
+    name: String,
+    align: Align,
+}
+
+impl Column {
+    /// A right-aligned column (numbers).
+    pub fn right(name: impl Into<String>) -> Self {
+        Column {
+            name: name.into(),
+            align: Align::Right,
+        }
+    }
+}
+
+impl From<&str> for Column {
+    fn from(name: &str) -> Self {
+        Column {
+            name: name.into(),
+            align: Align::Left,
+        }
+    }
+}
+
+impl From<String> for Column {
+    fn from(name: String) -> Self {
+        Column {
+            name,
+            align: Align::Left,
+        }
+    }
+}
+
+/// A Markdown table: a header row and rows of cells, rendered with `|` separators. Every
+/// table the host tools print is one of these; a `|` inside a cell is escaped.
 #[derive(Clone, Debug, Default, PartialEq, Eq)]
 pub struct Table {
-    header: Vec<String>,
+    header: Vec<Column>,
     rows: Vec<Vec<String>>,
 }
 
 impl Table {
-    /// A table with these column names.
-    pub fn new<S: Into<String>>(header: impl IntoIterator<Item = S>) -> Self {
+    /// A table with these columns (names, or [`Column`]s for alignment).
+    pub fn new<C: Into<Column>>(header: impl IntoIterator<Item = C>) -> Self {
         Table {
             header: header.into_iter().map(Into::into).collect(),
             rows: Vec::new(),
@@ -38,10 +86,10 @@ impl Table {
     /// The table as Markdown, ending in a newline.
     pub fn render(&self) -> String {
         let mut s = String::new();
-        let line = |s: &mut String, cells: &[String], n: usize| {
+        let line = |s: &mut String, cells: &[&str], n: usize| {
             s.push('|');
             for k in 0..n {
-                let c = cells.get(k).map(String::as_str).unwrap_or("");
+                let c = cells.get(k).copied().unwrap_or("");
                 let _ = write!(s, " {} |", c.replace('|', "\\|"));
             }
             s.push('\n');
@@ -53,12 +101,20 @@ impl Table {
             .chain([self.header.len()])
             .max()
             .unwrap_or(0);
-        line(&mut s, &self.header, n);
+        let names: Vec<&str> = self.header.iter().map(|c| c.name.as_str()).collect();
+        line(&mut s, &names, n);
         s.push('|');
-        s.push_str(&"---|".repeat(n));
+        for k in 0..n {
+            let align = self.header.get(k).map(|c| c.align).unwrap_or_default();
+            s.push_str(match align {
+                Align::Left => "---|",
+                Align::Right => "---:|",
+            });
+        }
         s.push('\n');
         for r in &self.rows {
-            line(&mut s, r, n);
+            let cells: Vec<&str> = r.iter().map(String::as_str).collect();
+            line(&mut s, &cells, n);
         }
         s
     }
@@ -135,6 +191,13 @@ mod tests {
         let mut t = Table::new(["a", "b"]);
         t.row(["1", "x|y"]);
         assert_eq!(t.render(), "| a | b |\n|---|---|\n| 1 | x\\|y |\n");
+    }
+
+    #[test]
+    fn right_columns_get_the_numeric_separator_and_short_rows_pad() {
+        let mut t = Table::new([Column::from("name"), Column::right("n")]);
+        t.row(["a"]);
+        assert_eq!(t.render(), "| name | n |\n|---|---:|\n| a |  |\n");
     }
 
     #[test]

@@ -8,6 +8,7 @@ use anyhow::{Context, Result};
 use crate::io::csv_trace;
 use crate::io::trace::Ranges;
 
+use crate::eval::markdown::{Column, Table};
 use crate::eval::matching::{mean, ratio, PhaseTally, Tally};
 use crate::eval::scoring::DatasetResult;
 use crate::eval::stats::{abs_quantile, median};
@@ -34,20 +35,31 @@ fn fmt_ms(v: &[f64]) -> String {
     }
 }
 
+/// The columns [`detection_cells`] fills.
+const DETECTION_COLUMNS: [&str; 8] = [
+    "found",
+    "extra",
+    "missed",
+    "not scored",
+    "unbordered movements",
+    "precision",
+    "recall",
+    "F1",
+];
+
 /// The cells `found | extra | missed | not scored | unbordered | precision | recall | F1`
 /// of a tally.
-fn detection_cells(t: &Tally) -> String {
-    format!(
-        "{} | {} | {} | {} | {} | {} | {} | {}",
-        t.tp,
-        t.fp,
-        t.fn_,
-        t.unscored,
-        t.unbordered,
+fn detection_cells(t: &Tally) -> [String; 8] {
+    [
+        t.tp.to_string(),
+        t.fp.to_string(),
+        t.fn_.to_string(),
+        t.unscored.to_string(),
+        t.unbordered.to_string(),
         fmt3(t.precision()),
         fmt3(t.recall()),
-        fmt3(t.f1())
-    )
+        fmt3(t.f1()),
+    ]
 }
 
 fn phase_cell(p: &PhaseTally) -> String {
@@ -61,79 +73,96 @@ fn phase_cell(p: &PhaseTally) -> String {
 /// The Markdown table: one row per dataset and an overall row; with rotations, one more
 /// table of the rotated runs pooled and the largest change of any rotation.
 pub fn table(results: &[DatasetResult]) -> String {
-    let mut s = String::new();
-    let header = "| dataset | trials | clean strides | found | extra | missed | not scored | unbordered movements | precision | recall | F1 | toe-off \\|error\\| ms: median / p95 (signed median) | heel-strike \\|error\\| ms: median / p95 (signed median) | swing F / IoU | contact F / IoU | stance F1 | zero-velocity instants in a Vicon stance |\n|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|\n";
-    let row = |s: &mut String, name: &str, t: &Tally| {
-        let _ = writeln!(
-            s,
-            "| {name} | {} | {} | {} | {} | {} | {} | {} | {} | {} |",
-            t.trials,
-            t.clean,
-            detection_cells(t),
-            fmt_ms(&t.toe_off_ms),
-            fmt_ms(&t.heel_strike_ms),
-            phase_cell(&t.swing),
-            phase_cell(&t.contact),
-            t.stance_f1().map_or("–".into(), fmt3),
-            t.instants.map_or("–".into(), |(i, n)| format!(
-                "{i} / {n} ({:.1} %)",
-                100.0 * ratio(i as f64, n as f64)
-            )),
-        );
+    let header = || {
+        let mut h: Vec<&str> = vec!["dataset", "trials", "clean strides"];
+        h.extend(DETECTION_COLUMNS);
+        h.extend([
+            "toe-off |error| ms: median / p95 (signed median)",
+            "heel-strike |error| ms: median / p95 (signed median)",
+            "swing F / IoU",
+            "contact F / IoU",
+            "stance F1",
+            "zero-velocity instants in a Vicon stance",
+        ]);
+        Table::new(h)
     };
-    s.push_str(header);
+    let row = |t: &mut Table, name: &str, y: &Tally| {
+        let mut r = vec![name.to_string(), y.trials.to_string(), y.clean.to_string()];
+        r.extend(detection_cells(y));
+        r.extend([
+            fmt_ms(&y.toe_off_ms),
+            fmt_ms(&y.heel_strike_ms),
+            phase_cell(&y.swing),
+            phase_cell(&y.contact),
+            y.stance_f1().map_or("–".into(), fmt3),
+            y.instants.map_or("–".into(), |(i, n)| {
+                format!("{i} / {n} ({:.1} %)", 100.0 * ratio(i as f64, n as f64))
+            }),
+        ]);
+        t.row(r);
+    };
+    let mut t = header();
     let mut overall = Tally::default();
     for r in results {
-        row(&mut s, &r.name, &r.tally);
+        row(&mut t, &r.name, &r.tally);
         overall.add(&r.tally);
     }
     if results.len() > 1 {
-        row(&mut s, "**overall**", &overall);
+        row(&mut t, "**overall**", &overall);
     }
+    let mut s = t.render();
     let n = results.first().map_or(0, |r| r.rotated.len());
     if n > 0 {
         let _ = writeln!(s, "\nAfter {n} random rotations of every trace (pooled):\n");
-        s.push_str(header);
+        let mut t = header();
         let mut overall = Tally::default();
         for r in results {
             let mut pooled = Tally::default();
-            for t in &r.rotated {
-                pooled.add(t);
+            for x in &r.rotated {
+                pooled.add(x);
             }
-            row(&mut s, &r.name, &pooled);
+            row(&mut t, &r.name, &pooled);
             overall.add(&pooled);
         }
         if results.len() > 1 {
-            row(&mut s, "**overall**", &overall);
+            row(&mut t, "**overall**", &overall);
         }
+        s.push_str(&t.render());
         let _ = writeln!(
             s,
-            "\nLargest change of any single rotation from the unrotated figures:\n\n| dataset | F1 | toe-off median ms | heel-strike median ms | swing IoU | stance F1 |\n|---|---|---|---|---|---|"
+            "\nLargest change of any single rotation from the unrotated figures:\n"
         );
+        let mut t = Table::new([
+            "dataset",
+            "F1",
+            "toe-off median ms",
+            "heel-strike median ms",
+            "swing IoU",
+            "stance F1",
+        ]);
         for r in results {
-            let t = &r.tally;
+            let y = &r.tally;
             let d = |f: &dyn Fn(&Tally) -> f64| {
                 r.rotated
                     .iter()
-                    .map(|x| (f(x) - f(t)).abs())
+                    .map(|x| (f(x) - f(y)).abs())
                     .filter(|v| !v.is_nan())
                     .fold(0.0f64, f64::max)
             };
-            let _ = writeln!(
-                s,
-                "| {} | {:.3} | {:.1} | {:.1} | {:.3} | {} |",
-                r.name,
-                d(&|x| x.f1()),
-                d(&|x| abs_quantile(&x.toe_off_ms, 0.5)),
-                d(&|x| abs_quantile(&x.heel_strike_ms, 0.5)),
-                d(&|x| x.swing.mean_iou()),
-                if t.stance.is_some() {
+            t.row([
+                r.name.clone(),
+                format!("{:.3}", d(&|x| x.f1())),
+                format!("{:.1}", d(&|x| abs_quantile(&x.toe_off_ms, 0.5))),
+                format!("{:.1}", d(&|x| abs_quantile(&x.heel_strike_ms, 0.5))),
+                format!("{:.3}", d(&|x| x.swing.mean_iou())),
+                if y.stance.is_some() {
                     format!("{:.3}", d(&|x| x.stance_f1().unwrap_or(f64::NAN)))
                 } else {
                     "–".into()
                 },
-            );
+            ]);
         }
+        s.push_str(&t.render());
     }
     s
 }
@@ -141,9 +170,20 @@ pub fn table(results: &[DatasetResult]) -> String {
 /// What the recordings' stamps and holes cost, per dataset: the replay's summaries
 /// ([`crate::replay::Summary`]) of every trial added up.
 pub fn data_table(datasets: &[Dataset]) -> Result<String> {
-    let mut s = String::from(
-        "| dataset | trials | samples read | repeated samples dropped | trials with holes | holes (samples lost) | bridged holes (samples) | gap holes: filled / restart (samples) | strides | bridged strides | gap strides | trials re-timed (stamps off the clock) |\n|---|---:|---:|---:|---:|---|---|---|---:|---:|---:|---|\n",
-    );
+    let mut table = Table::new([
+        Column::from("dataset"),
+        Column::right("trials"),
+        Column::right("samples read"),
+        Column::right("repeated samples dropped"),
+        Column::right("trials with holes"),
+        Column::from("holes (samples lost)"),
+        Column::from("bridged holes (samples)"),
+        Column::from("gap holes: filled / restart (samples)"),
+        Column::right("strides"),
+        Column::right("bridged strides"),
+        Column::right("gap strides"),
+        Column::from("trials re-timed (stamps off the clock)"),
+    ]);
     for d in datasets {
         let mut t = crate::replay::Summary::default();
         let (mut holed, mut retimed) = (0, 0);
@@ -156,35 +196,39 @@ pub fn data_table(datasets: &[Dataset]) -> Result<String> {
             retimed += (one.retimed_stamps > 0) as usize;
             t.add(&one);
         }
-        let _ = writeln!(
-            s,
-            "| {} | {} | {} | {} | {holed} | {} ({}) | {} ({}) | {} / {} ({}) | {} | {} | {} | {retimed} ({}) |",
-            d.name,
-            d.trials.len(),
-            t.samples_read,
-            t.repeated_dropped,
-            t.holes,
-            t.lost_samples,
-            t.bridged,
-            t.bridged_samples,
-            t.gaps_filled,
-            t.gaps - t.gaps_filled,
-            t.gap_samples,
-            t.strides,
-            t.bridged_strides,
-            t.gap_strides,
-            t.retimed_stamps,
-        );
+        table.row([
+            d.name.clone(),
+            d.trials.len().to_string(),
+            t.samples_read.to_string(),
+            t.repeated_dropped.to_string(),
+            holed.to_string(),
+            format!("{} ({})", t.holes, t.lost_samples),
+            format!("{} ({})", t.bridged, t.bridged_samples),
+            format!(
+                "{} / {} ({})",
+                t.gaps_filled,
+                t.gaps - t.gaps_filled,
+                t.gap_samples
+            ),
+            t.strides.to_string(),
+            t.bridged_strides.to_string(),
+            t.gap_strides.to_string(),
+            format!("{retimed} ({})", t.retimed_stamps),
+        ]);
     }
-    Ok(s)
+    Ok(table.render())
 }
 
 /// Step detection side by side: one row per dataset and detector (the `Tally` of each, as
 /// recorded), with Lu's eq. 13 step-count error as the mean over trials and pooled.
 pub fn detectors_table(rows: &[(&str, &str, &Tally)]) -> String {
-    let mut s = String::from(
-        "| dataset | detector | strides (all / clean) | detected | found | extra | missed | not scored | unbordered movements | precision | recall | F1 | count error (eq. 13): mean of trials / pooled | too long (merged) |\n|---|---|---|---|---|---|---|---|---|---|---|---|---|---|\n",
-    );
+    let mut h: Vec<&str> = vec!["dataset", "detector", "strides (all / clean)", "detected"];
+    h.extend(DETECTION_COLUMNS);
+    h.extend([
+        "count error (eq. 13): mean of trials / pooled",
+        "too long (merged)",
+    ]);
+    let mut table = Table::new(h);
     for (dataset, detector, t) in rows {
         let pct = |v: f64| {
             if v.is_nan() {
@@ -193,17 +237,20 @@ pub fn detectors_table(rows: &[(&str, &str, &Tally)]) -> String {
                 format!("{:.1} %", 100.0 * v)
             }
         };
-        let _ = writeln!(
-            s,
-            "| {dataset} | {detector} | {} / {} | {} | {} | {} / {} | {} |",
-            t.references,
-            t.clean,
-            t.detected,
-            detection_cells(t),
+        let mut r = vec![
+            dataset.to_string(),
+            detector.to_string(),
+            format!("{} / {}", t.references, t.clean),
+            t.detected.to_string(),
+        ];
+        r.extend(detection_cells(t));
+        r.push(format!(
+            "{} / {}",
             pct(mean(&t.count_errors)),
-            pct(t.pooled_count_error()),
-            t.too_long,
-        );
+            pct(t.pooled_count_error())
+        ));
+        r.push(t.too_long.to_string());
+        table.row(r);
     }
-    s
+    table.render()
 }

@@ -16,7 +16,6 @@
 //!   first stride would be lost entirely.
 
 use gaitclip::sensor::sample::RangeScale;
-use std::fmt::Write as _;
 use std::path::Path;
 
 use anyhow::{Context, Result};
@@ -25,6 +24,7 @@ use gaitclip::pipeline::Pipeline;
 use gaitclip_board::replay_mpu6050::{mg_to_counts, motion_between, REPLAY_MOTION_UNIT};
 use gaitclip_board::sleep::SLEEP;
 
+use crate::eval::markdown::{Column, Table};
 use crate::io::datasets;
 use crate::io::trace::Ranges;
 
@@ -155,13 +155,16 @@ pub fn report(root: &Path) -> Result<(Vec<WakeResult>, String)> {
             rows.push(r);
         }
     }
-    let mut o = String::new();
-    let _ = writeln!(
-        o,
-        "| dataset | threshold, mg | stands ≥ {MIN_STAND_S} s ended by a walk | woke > {EARLY_S} s early | latency median, ms | latency 90th pct, ms | slept through the first {MISSED_S} s |\n|---|---:|---:|---:|---:|---:|---:|"
-    );
-    let results_for_table = rows;
-    for r in &results_for_table {
+    let mut table = Table::new([
+        Column::from("dataset"),
+        Column::right("threshold, mg"),
+        Column::right(format!("stands ≥ {MIN_STAND_S} s ended by a walk")),
+        Column::right(format!("woke > {EARLY_S} s early")),
+        Column::right("latency median, ms"),
+        Column::right("latency 90th pct, ms"),
+        Column::right(format!("slept through the first {MISSED_S} s")),
+    ]);
+    for r in &rows {
         let mut l = r.latencies_s.clone();
         l.sort_by(f64::total_cmp);
         let q = |f: f64| {
@@ -173,17 +176,16 @@ pub fn report(root: &Path) -> Result<(Vec<WakeResult>, String)> {
         } else {
             ""
         };
-        let _ = writeln!(
-            o,
-            "| {} | {}{mark} | {} | {} | {:.0} | {:.0} | {} |",
-            r.dataset,
-            r.threshold_mg,
-            r.stands,
-            r.woke_early,
-            q(0.5),
-            q(0.9),
-            r.slept_through
-        );
+        table.row([
+            r.dataset.to_string(),
+            format!("{}{mark}", r.threshold_mg),
+            r.stands.to_string(),
+            r.woke_early.to_string(),
+            format!("{:.0}", q(0.5)),
+            format!("{:.0}", q(0.9)),
+            r.slept_through.to_string(),
+        ]);
     }
+    let o = table.render();
     Ok((results, o))
 }

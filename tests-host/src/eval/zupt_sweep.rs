@@ -24,6 +24,7 @@ use gaitclip::record::stride::StrideFlags;
 use gaitclip::sensor::sample::{AccelRange, GyroRange};
 
 use crate::eval::length_eval::SPEED_BINS;
+use crate::eval::markdown::Table;
 use crate::eval::matching::{self, Detected, Scored};
 use crate::io::datasets;
 use crate::io::trace::Ranges;
@@ -112,43 +113,44 @@ pub fn report(root: &Path) -> Result<String> {
         s,
         "ZUPT stride by sensor height above the rolling contact (cycle detector, ±2000 °/s; RMSE / bias cm (strides)):\n"
     )?;
-    write!(s, "| height |")?;
+    let mut header = vec!["height".to_string()];
     for d in &sets {
-        write!(s, " {} all |", d.name)?;
+        header.push(format!("{} all", d.name));
         for b in SPEED_BINS.iter().take(4) {
-            write!(s, " {} {} |", d.name, bin_name(*b))?;
+            header.push(format!("{} {}", d.name, bin_name(*b)));
         }
     }
-    writeln!(s)?;
-    writeln!(s, "|---|{}", "---|".repeat(sets.len() * 5))?;
+    let mut by_height = Table::new(header);
     for h in HEIGHTS_MM {
-        write!(s, "| {h} mm |")?;
+        let mut row = vec![format!("{h} mm")];
         for d in &sets {
             let e = errors(d, Ranges::default(), h * 1000)?;
             let all: Vec<f64> = e.iter().map(|x| x.1).collect();
-            write!(s, " {} |", cell(&all))?;
+            row.push(cell(&all));
             for (lo, hi) in SPEED_BINS.iter().take(4).copied() {
                 let b: Vec<f64> = e
                     .iter()
                     .filter(|x| x.0 >= lo && x.0 < hi)
                     .map(|x| x.1)
                     .collect();
-                write!(s, " {} |", cell(&b))?;
+                row.push(cell(&b));
             }
         }
-        writeln!(s)?;
+        by_height.row(row);
     }
+    s.push_str(&by_height.render());
     writeln!(
         s,
         "\nZUPT stride by gyro full-scale range (cycle detector, sensor height {} mm; RMSE / bias cm (strides)):\n",
         gaitclip::detect::cycle::SENSOR_HEIGHT_UM / 1000
     )?;
-    write!(s, "| gyro range |")?;
+    let mut header = vec!["gyro range".to_string()];
     for d in &sets {
-        write!(s, " {0} all | {0} clipped | {0} not clipped |", d.name)?;
+        header.push(format!("{} all", d.name));
+        header.push(format!("{} clipped", d.name));
+        header.push(format!("{} not clipped", d.name));
     }
-    writeln!(s)?;
-    writeln!(s, "|---|{}", "---|".repeat(sets.len() * 3))?;
+    let mut by_range = Table::new(header);
     for (gyro, label) in [
         (GyroRange::Dps2000, "±2000 °/s"),
         (GyroRange::Dps500, "±500 °/s"),
@@ -158,21 +160,18 @@ pub fn report(root: &Path) -> Result<String> {
             accel: AccelRange::G16,
             gyro,
         };
-        write!(s, "| {label} |")?;
+        let mut row = vec![label.to_string()];
         for d in &sets {
             let e = errors(d, ranges, gaitclip::detect::cycle::SENSOR_HEIGHT_UM)?;
             let pick = |f: &dyn Fn(&Scoredstride) -> bool| -> Vec<f64> {
                 e.iter().filter(|x| f(x)).map(|x| x.1).collect()
             };
-            write!(
-                s,
-                " {} | {} | {} |",
-                cell(&pick(&|_| true)),
-                cell(&pick(&|x| x.2)),
-                cell(&pick(&|x| !x.2))
-            )?;
+            row.push(cell(&pick(&|_| true)));
+            row.push(cell(&pick(&|x| x.2)));
+            row.push(cell(&pick(&|x| !x.2)));
         }
-        writeln!(s)?;
+        by_range.row(row);
     }
+    s.push_str(&by_range.render());
     Ok(s)
 }
