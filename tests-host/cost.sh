@@ -9,6 +9,9 @@
 set -euo pipefail
 root=$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)
 cd "$root"
+# The pinned toolchain with its Cortex-M targets: rustup adds them only when it installs the
+# toolchain, not to one already there without them (as test-all.sh and `cargo emulate` do).
+rustup toolchain install >&2
 bash boards/install-qemu >&2
 bash boards/install-clang >&2
 command -v flip-link >/dev/null 2>&1 || cargo install --locked flip-link >&2
