@@ -188,6 +188,14 @@ enum Cmd {
         #[arg(default_value = "../../shared/datasets")]
         datasets: PathBuf,
     },
+    /// Time the core's toe-offs and heel-strikes against `gaitmap_walk`'s mocap events and
+    /// `ipol_gait_events`' annotations, beside the same events read from the foot's sagittal
+    /// angular rate (docs/accuracy.md's event timing table).
+    Events {
+        /// The folder holding the datasets (`../shared/datasets`).
+        #[arg(default_value = "../../shared/datasets")]
+        datasets: PathBuf,
+    },
     /// Clip `gaitmap_walk` and `pyshoe_vicon` at ±8 g, ±4 g and ±12 g and compare each clipped
     /// stride with its unclipped self, with the loss left in and put back.
     Clipping {
@@ -658,6 +666,9 @@ fn run(cli: Cli) -> anyhow::Result<()> {
         }
         Cmd::ZuptSweep { datasets } => {
             print!("{}", gaitclip_host::eval::zupt_sweep::report(&datasets)?);
+        }
+        Cmd::Events { datasets } => {
+            print!("{}", gaitclip_host::eval::event_timing::report(&datasets)?);
         }
         Cmd::Clipping { datasets } => {
             print!("{}", gaitclip_host::eval::clip_sweep::report(&datasets)?);

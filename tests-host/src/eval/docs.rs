@@ -36,7 +36,15 @@ pub const GENERATORS: &[(&str, Generator)] = &[
 
 /// The subcommands of the `gaitclip` binary a marker may run as a whole command line: the
 /// ones that print deterministic Markdown (no time, no machine figure).
-pub const COMMANDS: &[&str] = &["eval", "gait", "holes", "wake", "zupt-sweep", "energy"];
+pub const COMMANDS: &[&str] = &[
+    "eval",
+    "gait",
+    "holes",
+    "wake",
+    "zupt-sweep",
+    "energy",
+    "events",
+];
 
 const OPEN: &str = "<!-- generated: gaitclip ";
 const CLOSE: &str = "<!-- end generated -->";

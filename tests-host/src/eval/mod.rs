@@ -2,6 +2,7 @@
 
 pub mod clip_sweep;
 pub mod docs;
+pub mod event_timing;
 pub mod flag_costs;
 pub mod gait_eval;
 pub mod hole_sweep;
