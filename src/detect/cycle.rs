@@ -674,7 +674,13 @@ impl<const M: usize> CycleDetector<M> {
         let heel_off = self.cur.as_ref().and_then(|c| c.heel_off);
         let (movement_len, needed) = match (heel_off, self.cand.as_ref()) {
             (None, _) => (0, 0),
-            (Some(h), Some(old)) if old.next_heel_off.is_some() => {
+            // The old candidate's stance had ended (its next heel-off came) and this low
+            // stretch is a later one: the buffer skips the old stance's samples.
+            (Some(h), Some(old))
+                if old
+                    .next_heel_off
+                    .is_some_and(|nh| ff.wrapping_sub(nh) < u32::MAX / 2) =>
+            {
                 let nh = old.next_heel_off.unwrap_or(h);
                 let skipped = nh.wrapping_sub(old.foot_flat);
                 let tail_pos = old.tail_pos;
@@ -684,14 +690,26 @@ impl<const M: usize> CycleDetector<M> {
                 let len = tail_pos + ff.wrapping_sub(nh).min(self.max_movement as u32) as usize;
                 (len.min(self.movement.len()), ff.wrapping_sub(h))
             }
+            // The movement ends where this low stretch began, at its buffer position: past
+            // a skip only if it lies after it. (A stance that stirred, took its wiggle for
+            // the next heel-off and settled again has its foot-flat before the skip: taking
+            // the skip off there cut the swing's last samples, its heel-strike among them.)
             (Some(h), _) => {
                 let needed = ff.wrapping_sub(h);
                 let needed = if needed < u32::MAX / 2 { needed } else { 0 };
-                let skipped = self.mv_gap.map_or(0, |g| g.1);
-                (
-                    (needed.saturating_sub(skipped) as usize).min(self.movement.len()),
-                    needed,
-                )
+                let pos = match self.mv_gap {
+                    Some((at, skipped)) if needed as usize > at => {
+                        (needed.saturating_sub(skipped) as usize).max(at)
+                    }
+                    _ => needed as usize,
+                };
+                // Past an old candidate's next heel-off the buffer holds that movement's
+                // samples, not this stretch's.
+                let stored = match self.cand.as_ref() {
+                    Some(old) if old.next_heel_off.is_some() => old.tail_pos,
+                    _ => self.movement.len(),
+                };
+                (pos.min(stored).min(self.movement.len()), needed)
             }
         };
         // The next stride's integrator, started in place (an integrator is ≈ 300 B and the
