@@ -178,7 +178,7 @@ impl CycleConfig {
             rolling: RollingContact::new(sensor_height_um, rate, gyro),
             phases,
             merge: rate.samples_in_ms(phases::MERGE_MS),
-            integrator: ZuptIntegrator::new(rate, gyro),
+            integrator: ZuptIntegrator::new(rate, accel, gyro),
             rails,
             restore_accel: true,
         }
@@ -348,6 +348,12 @@ impl<const M: usize> CycleDetector<M> {
             config.sensor_height_um,
         );
         cfg.restore_accel = config.restore_accel;
+        cfg.integrator = ZuptIntegrator::reading(
+            config.rate,
+            config.accel,
+            config.gyro,
+            config.gravity_reading,
+        );
         Self::with_config(cfg)
     }
 
@@ -666,7 +672,8 @@ impl<const M: usize> CycleDetector<M> {
         if gravity_q8 <= 0 {
             return;
         }
-        let v0 = self.cfg.rolling.velocity_q8(level, omega, gravity_q8);
+        let unit_q8 = self.cfg.integrator.unit_q8_for(gravity_q8);
+        let v0 = self.cfg.rolling.velocity_q8(level, omega, unit_q8);
         // Where the stride's movement ends in the buffer: at this low stretch's start. A
         // candidate that replaces one after the energy rose (a slow swing's dip) keeps the
         // samples stored since that one's "heel-off" after the movement so far.
@@ -760,7 +767,8 @@ impl<const M: usize> CycleDetector<M> {
         let Some(level) = QuatQ30::level_from_up(mean) else {
             return;
         };
-        let v0 = self.cfg.rolling.velocity_q8(level, omega, gravity_q8);
+        let unit_q8 = self.cfg.integrator.unit_q8_for(gravity_q8);
+        let v0 = self.cfg.rolling.velocity_q8(level, omega, unit_q8);
         let mut it = self.cfg.integrator;
         if !it.start_at(level, cal.gyro_bias, gravity_q8, v0) {
             return;
@@ -903,7 +911,7 @@ impl<const M: usize> CycleDetector<M> {
         }
         let v_end = cfg
             .rolling
-            .velocity_q8(c.snap.attitude(), c.omega, c.snap.gravity_q8());
+            .velocity_q8(c.snap.attitude(), c.omega, c.snap.unit_q8());
         let d = c
             .snap
             .displacement_restoring(v_end, c.gravity, &cfg.rails, cfg.restore_accel);

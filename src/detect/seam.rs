@@ -14,6 +14,7 @@ use crate::detect::foot_frame::FootFrameEstimator;
 use crate::detect::phase_stats::StrideStats;
 use crate::detect::phases::PhaseMethod;
 use crate::detect::stance::StanceLimits;
+use crate::detect::zupt::GravityReading;
 use crate::record::stride::{StepAmplitude, Stride};
 use crate::sensor::rate::SampleRate;
 use crate::sensor::sample::{Origin, Rails, RawSample};
@@ -77,6 +78,8 @@ pub struct DetectConfig {
     pub sensor_height_um: u32,
     /// Whether the cycle detector puts back what a clipped accelerometer lost.
     pub restore_accel: bool,
+    /// What the rest's reading of gravity is taken to be.
+    pub gravity_reading: GravityReading,
 }
 
 /// The delay lines: the last [`DELAY_CAPACITY`] raw samples' accelerations and angular

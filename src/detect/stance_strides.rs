@@ -47,11 +47,11 @@ use crate::detect::seam::{
     MAX_STANCE_IN_STRIDE_MS, MIN_MOVEMENT_MS,
 };
 use crate::detect::stance::{StanceDetector, StanceThresholds};
-use crate::detect::zupt::ZuptIntegrator;
+use crate::detect::zupt::{GravityReading, ZuptIntegrator};
 use crate::record::stride::{Stride, StrideEvents, StrideFlags};
 use crate::sensor::rate::SampleRate;
 use crate::sensor::sample::{Origin, Rails, RawSample};
-use crate::sensor::units::{FootAccel, GyroScale};
+use crate::sensor::units::{AccelScale, FootAccel, GyroScale};
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 enum State {
@@ -106,20 +106,30 @@ pub struct StrideTracker<const M: usize = MAX_MOVEMENT_SAMPLES> {
 
 impl StrideTracker {
     /// A tracker with the default movement buffer ([`MAX_MOVEMENT_SAMPLES`]) for a sample
-    /// rate and gyro range, splitting phases with `phase_method`.
-    pub const fn new(rate: SampleRate, gyro: GyroScale, phase_method: PhaseMethod) -> Self {
-        Self::sized(rate, gyro, phase_method)
+    /// rate and the sensor's ranges, splitting phases with `phase_method`.
+    pub const fn new(
+        rate: SampleRate,
+        accel: AccelScale,
+        gyro: GyroScale,
+        phase_method: PhaseMethod,
+    ) -> Self {
+        Self::sized(rate, accel, gyro, phase_method)
     }
 }
 
 impl<const M: usize> StrideTracker<M> {
     /// A tracker with a movement buffer of `M` samples.
-    pub const fn sized(rate: SampleRate, gyro: GyroScale, phase_method: PhaseMethod) -> Self {
+    pub const fn sized(
+        rate: SampleRate,
+        accel: AccelScale,
+        gyro: GyroScale,
+        phase_method: PhaseMethod,
+    ) -> Self {
         StrideTracker {
             state: State::Unprimed,
             min_movement: rate.samples_in_ms(MIN_MOVEMENT_MS),
             max_stance: rate.samples_in_ms(MAX_STANCE_IN_STRIDE_MS),
-            zupt: ZuptIntegrator::new(rate, gyro),
+            zupt: ZuptIntegrator::new(rate, accel, gyro),
             stance_start: 0,
             heel_off: 0,
             stance_sums: RestSums::new(),
@@ -148,6 +158,19 @@ impl<const M: usize> StrideTracker<M> {
     /// The tracker with each axis clipping at `rails` (by default the counts' extremes).
     pub const fn with_rails(mut self, rails: Rails) -> Self {
         self.rails = rails;
+        self
+    }
+
+    /// The tracker reading the rest's departure from 1 g as `reading` says
+    /// ([`GravityReading::Offset`] by default).
+    pub const fn with_gravity_reading(
+        mut self,
+        rate: SampleRate,
+        accel: AccelScale,
+        gyro: GyroScale,
+        reading: GravityReading,
+    ) -> Self {
+        self.zupt = ZuptIntegrator::reading(rate, accel, gyro, reading);
         self
     }
 
@@ -528,8 +551,14 @@ impl<const M: usize> StanceStrides<M> {
                 config.gyro,
                 config.stance,
             )),
-            tracker: StrideTracker::sized(config.rate, config.gyro, config.phases)
-                .with_rails(config.rails),
+            tracker: StrideTracker::sized(config.rate, config.accel, config.gyro, config.phases)
+                .with_rails(config.rails)
+                .with_gravity_reading(
+                    config.rate,
+                    config.accel,
+                    config.gyro,
+                    config.gravity_reading,
+                ),
             decided: 0,
             last_decision: false,
             held: None,
@@ -655,6 +684,7 @@ mod tests {
         let rate = SampleRate::from_hz(RATE_HZ).unwrap();
         StrideTracker::sized(
             rate,
+            crate::sensor::units::AccelScale::of(crate::sensor::sample::AccelRange::G16),
             crate::sensor::units::GyroScale::of(crate::sensor::sample::GyroRange::Dps2000),
             PhaseMethod::Augmented,
         )

@@ -9,6 +9,20 @@
 //! velocity should be zero again; what is left is drift, assumed to have grown linearly over
 //! the movement, and removed from the displacement in closed form (no sample buffer).
 //!
+//! **What the rest's reading of gravity means.** At rest the accelerometer should read 1 g;
+//! what it reads instead is how the sensor errs along gravity, and nothing else: the axes
+//! that measure the stride lie across it. That departure is taken for an offset along
+//! gravity ([`GravityReading::Offset`], the default): removed from every sample as a vector
+//! fixed to the sensor, and the counts turned into metres at the sensor's own scale (counts
+//! per g). Taking it for a gain on every axis instead ([`GravityReading::Gain`], lengths in
+//! units of the rest's gravity, gaitclip's rule until the bias study) turns an offset along
+//! the vertical into an error of every length. Measured (`gaitclip bias`, docs/accuracy.md):
+//! `ipol_gait_events`' left-foot sensors read gravity 4.8 % high, the right 1.0 %; read as a
+//! gain, the left foot walked 2.67 % (median) less than the right on the same walks; as an
+//! offset, 0.47 % less. A 0.5 m/s² offset along gravity made `gaitmap_walk`'s strides 4.7 cm
+//! shorter read as a gain, 2.4 cm longer left in, and not at all removed. The departure
+//! removed is bounded by [`MAX_GRAVITY_OFFSET_MILLI_G`].
+//!
 //! Everything per sample is integer: Q30 quaternion, accelerations in counts·2⁸, velocity and
 //! position as `i64` sums. Ranges: movements up to 2³¹ samples do not overflow (velocity
 //! < 2²³·n, doubled position < 2²⁴·n²; `i64` holds n = 2²⁰ with margin).
@@ -19,7 +33,7 @@ use crate::fixed::{atan2_cdeg, div_round_i128, isqrt_u64, QuatQ30};
 use crate::record::stride::Stride;
 use crate::sensor::rate::SampleRate;
 use crate::sensor::sample::{Rails, RawSample};
-use crate::sensor::units::GyroScale;
+use crate::sensor::units::{AccelScale, GyroScale};
 
 /// π · 2³².
 const PI_Q32: u128 = 13_493_037_705;
@@ -39,7 +53,7 @@ impl RollingContact {
     /// For a sensor `height_um` above the contact, at `rate` with gyro range `gyro`.
     /// Range: heights up to 1 m, any supported rate.
     pub const fn new(height_um: u32, rate: SampleRate, gyro: GyroScale) -> Self {
-        // v_q8 = ω_counts · (π/180)/lsb · h · gravity_q8 · rate / g, with ω·(π/180)/lsb in
+        // v_q8 = ω_counts · (π/180)/lsb · h · unit_q8 · rate / g, with ω·(π/180)/lsb in
         // rad/s: π·10·h_um·rate_mHz / (180·lsb10·1e6·1e3·9.80665) per (count · count·2⁸).
         let num = PI_Q32 * 10 * height_um as u128 * rate.millihertz() as u128;
         let den = 180 * gyro.lsb_per_dps_x10() as u128 * 9_806_650_000u128;
@@ -51,7 +65,8 @@ impl RollingContact {
     }
 
     /// The sensor's velocity in the level frame of `attitude` for the body rate
-    /// `gyro_minus_bias` (counts), in the integrator's units for `gravity_q8`:
+    /// `gyro_minus_bias` (counts), in the integrator's units for `unit_q8` (the counts·2⁸
+    /// that stand for 1 g, [`ZuptIntegrator::unit_q8`]):
     /// `(q·ω) × (0, 0, h)` = `(ω_y·h, −ω_x·h, 0)`. The level-frame rate is kept in
     /// counts·2⁸ (whole counts would cost up to 2·10⁻⁵ m/s at ±2000 °/s and 4 cm): within
     /// 10⁻⁴ relative and 10 µm/s of the exact velocity (host test). Range: rates up to 2¹⁷
@@ -60,7 +75,7 @@ impl RollingContact {
         &self,
         attitude: QuatQ30,
         gyro_minus_bias: [i32; 3],
-        gravity_q8: i64,
+        unit_q8: i64,
     ) -> [i64; 3] {
         let r = attitude.matrix();
         let w = |row: &[i32; 3]| -> i64 {
@@ -73,7 +88,7 @@ impl RollingContact {
         };
         let (wx, wy) = (w(&r[0]), w(&r[1]));
         let scale = |v: i64| -> i64 {
-            let p = v as i128 * gravity_q8 as i128 * self.factor_q40 as i128;
+            let p = v as i128 * unit_q8 as i128 * self.factor_q40 as i128;
             ((p + (1 << 47)) >> 48).clamp(i64::MIN as i128, i64::MAX as i128) as i64
         };
         [scale(wy), scale(-wx), 0]
@@ -82,9 +97,10 @@ impl RollingContact {
 
 /// Points of the vertical trajectory an integrator keeps for the sensor's highest point
 /// ([`Displacement::max_lift_um`]): a movement of `n` samples is kept every
-/// `2^⌈log₂(n/LIFT_POINTS)⌉` samples, every fourth at 200 Hz for a 1 s stride. At the top the
-/// vertical velocity is zero, so a point `k` samples from it is low by only `a·(k·dt)²/2`:
-/// under 1 mm for the ±2 samples of a walking stride at 200 Hz (a ≈ 10 m/s² at the top).
+/// `2^⌈log₂(n/LIFT_POINTS)⌉` samples, every eighth at 200 Hz for a 0.64–1.28 s stride. At the
+/// top the vertical velocity is zero, so a point `k` samples from it is low by only
+/// `a·(k·dt)²/2`: up to 2 mm for the ±4 samples of a walking stride at 200 Hz (a ≈ 10 m/s² at
+/// the top; 2.0 mm the worst of the demo fixture's strides in `fixed_point.rs`).
 pub const LIFT_POINTS: usize = 32;
 
 /// Displacement of the foot over one movement, in the level frame.
@@ -113,12 +129,37 @@ impl Displacement {
     }
 }
 
+/// What the accelerometer's reading of gravity at rest, where it is not 1 g, is taken to be
+/// (the module's essay: *What the rest's reading of gravity means*).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum GravityReading {
+    /// An offset along gravity, fixed to the sensor: removed from every sample; lengths at
+    /// the sensor's scale. The default.
+    Offset,
+    /// A gain on every axis: lengths in units of the rest's gravity (gaitclip's rule until
+    /// the bias study; kept for its comparison).
+    Gain,
+    /// Neither: lengths at the sensor's scale, the departure left in (the bias study's middle
+    /// case).
+    Ignored,
+}
+
+/// The largest departure of the rest's gravity from 1 g removed as an offset, milli-g: the
+/// MPU6050's zero-g tolerance along z is ±80 mg (PS-MPU-6000A-00 rev. 3.4, §6.2); a larger
+/// departure is not an offset of a working sensor, and only this much of it is removed.
+pub const MAX_GRAVITY_OFFSET_MILLI_G: i64 = 100;
+
 /// Strapdown integrator for one movement.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct ZuptIntegrator {
     /// Gyro counts → Q30 half-angle per sample, scaled by 2¹⁶.
     half_angle_per_count_q46: i64,
     rate: SampleRate,
+    /// The sensor's 1 g, counts·2⁸.
+    nominal_g_q8: i64,
+    reading: GravityReading,
+    /// The offset removed from every sample (sensor axes, counts·2⁸; [`GravityReading::Offset`]).
+    offset_q8: [i32; 3],
     attitude: QuatQ30,
     start_attitude: QuatQ30,
     gyro_bias: [i32; 3],
@@ -144,14 +185,28 @@ pub struct ZuptIntegrator {
 }
 
 impl ZuptIntegrator {
-    /// An idle integrator for a sample rate and gyro range.
-    pub const fn new(rate: SampleRate, gyro: GyroScale) -> Self {
+    /// An idle integrator for a sample rate and the sensor's ranges, the rest's departure
+    /// from 1 g read as an offset ([`GravityReading::Offset`]).
+    pub const fn new(rate: SampleRate, accel: AccelScale, gyro: GyroScale) -> Self {
+        Self::reading(rate, accel, gyro, GravityReading::Offset)
+    }
+
+    /// An idle integrator that reads the rest's departure from 1 g as `reading` says.
+    pub const fn reading(
+        rate: SampleRate,
+        accel: AccelScale,
+        gyro: GyroScale,
+        reading: GravityReading,
+    ) -> Self {
         // rad per count / (2 · rate) · 2⁴⁶ = π·10⁴·2⁴⁶ / (360 · lsb10 · rate_mHz).
         let num = PI_Q32 * (1 << 14) * 10_000;
         let den = 360 * gyro.lsb_per_dps_x10() as u128 * rate.millihertz() as u128;
         ZuptIntegrator {
             half_angle_per_count_q46: ((num + den / 2) / den) as i64,
             rate,
+            nominal_g_q8: (accel.lsb_per_g() as i64) << 8,
+            reading,
+            offset_q8: [0; 3],
             attitude: QuatQ30::IDENTITY,
             start_attitude: QuatQ30::IDENTITY,
             gyro_bias: [0; 3],
@@ -213,6 +268,16 @@ impl ZuptIntegrator {
         self.start_attitude = level;
         self.gyro_bias = gyro_bias;
         self.gravity_q8 = gravity_q8;
+        self.offset_q8 = [0; 3];
+        if let GravityReading::Offset = self.reading {
+            // The departure from 1 g, bounded, along the level frame's up in sensor axes
+            // (the matrix's last row, Q30): |d| ≤ 0.1 g < 2¹⁸ counts·2⁸ at any range.
+            let bound = self.nominal_g_q8 * MAX_GRAVITY_OFFSET_MILLI_G / 1000;
+            let d = (gravity_q8 - self.nominal_g_q8).clamp(-bound, bound);
+            let up = level.matrix()[2];
+            self.offset_q8 = up.map(|u| ((d * u as i64 + (1 << 29)) >> 30) as i32);
+            self.gravity_q8 = gravity_q8 - d;
+        }
         self.velocity_q8 = v0_q8;
         self.position_x2_q8 = [0; 3];
         self.samples = 0;
@@ -243,14 +308,35 @@ impl ZuptIntegrator {
     }
 
     /// The velocity now, in the level frame, in counts·2⁸ of the accelerometer summed over
-    /// samples: `v [m/s] = velocity_q8 · g / (gravity_q8 · rate)`.
+    /// samples: `v [m/s] = velocity_q8 · g / (unit_q8 · rate)` ([`ZuptIntegrator::unit_q8`]).
     pub const fn velocity_q8(&self) -> [i64; 3] {
         self.velocity_q8
     }
 
-    /// The gravity magnitude the integrator removes, counts·2⁸.
+    /// The gravity magnitude the integrator removes, counts·2⁸ (the rest's, less the offset
+    /// removed).
     pub const fn gravity_q8(&self) -> i64 {
         self.gravity_q8
+    }
+
+    /// The counts·2⁸ that stand for 1 g when the integral becomes metres: the sensor's scale,
+    /// or the rest's gravity read as a gain ([`GravityReading`]).
+    pub const fn unit_q8(&self) -> i64 {
+        self.unit_q8_for(self.gravity_q8)
+    }
+
+    /// [`ZuptIntegrator::unit_q8`] of a stride started with the rest gravity `gravity_q8`
+    /// (what the velocity imposed at its start is scaled by).
+    pub const fn unit_q8_for(&self, gravity_q8: i64) -> i64 {
+        match self.reading {
+            GravityReading::Gain => gravity_q8,
+            GravityReading::Offset | GravityReading::Ignored => self.nominal_g_q8,
+        }
+    }
+
+    /// The offset removed from every sample, sensor axes, counts·2⁸.
+    pub const fn offset_q8(&self) -> [i32; 3] {
+        self.offset_q8
     }
 
     /// The displacement, with the difference between the end velocity and `v_end_q8` (the
@@ -382,13 +468,16 @@ impl ZuptIntegrator {
         }
         self.attitude = self.attitude.integrate_half_angle(h);
         let r = self.attitude.matrix();
+        // The sample less the offset, counts·2⁸: |·| < 2²³ + 2¹⁹ < 2²⁴ (an i32, so that the
+        // products below stay 32 × 32 bits), × Q30 < 2⁵⁴, three of them < 2⁵⁶.
+        let f_q8: [i32; 3] = [0, 1, 2].map(|k| ((s.accel[k] as i32) << 8) - self.offset_q8[k]);
         for (i, row) in r.iter().enumerate() {
             let a: i64 = row
                 .iter()
-                .zip(s.accel.iter())
-                .map(|(&m, &a)| m as i64 * a as i64)
+                .zip(f_q8.iter())
+                .map(|(&m, &f)| m as i64 * f as i64)
                 .sum();
-            let mut a_q8 = (a + (1 << 21)) >> 22;
+            let mut a_q8 = (a + (1 << 29)) >> 30;
             if i == 2 {
                 a_q8 -= self.gravity_q8;
             }
@@ -475,7 +564,7 @@ impl ZuptIntegrator {
     fn displacement_of(&self, drift: [i64; 3], position_x2: [i64; 3]) -> Displacement {
         let n = self.samples as i128;
         let den = 2
-            * self.gravity_q8 as i128
+            * self.unit_q8() as i128
             * self.rate.millihertz() as i128
             * self.rate.millihertz() as i128;
         let um = |i: usize| {

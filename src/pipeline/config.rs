@@ -6,6 +6,7 @@
 use crate::detect::phases::PhaseMethod;
 use crate::detect::seam::{DetectConfig, MIN_MOVEMENT_MS};
 use crate::detect::stance::StanceLimits;
+use crate::detect::zupt::GravityReading;
 use crate::length::models::{Model, ModelParams, Settings};
 use crate::pipeline::detectors::Detector;
 use crate::sensor::rate::SampleRate;
@@ -68,6 +69,9 @@ pub struct Config {
     /// The sensor's height above the foot's rolling contact, µm
     /// ([`crate::detect::cycle::SENSOR_HEIGHT_UM`]): where the clip sits on the shoe.
     pub sensor_height_um: u32,
+    /// What the accelerometer's reading of gravity at rest, where it is not 1 g, is taken
+    /// to be ([`GravityReading::Offset`]; the others for the bias study's comparison).
+    pub gravity_reading: GravityReading,
 }
 
 impl Config {
@@ -89,6 +93,7 @@ impl Config {
             bridge_max_ms: BRIDGE_MAX_MS,
             stance: StanceLimits::DEFAULT,
             sensor_height_um: crate::detect::cycle::SENSOR_HEIGHT_UM,
+            gravity_reading: GravityReading::Offset,
         }
     }
 
@@ -109,6 +114,7 @@ impl Config {
             stance: self.stance,
             sensor_height_um: self.sensor_height_um,
             restore_accel: self.restore_accel,
+            gravity_reading: self.gravity_reading,
         }
     }
 }

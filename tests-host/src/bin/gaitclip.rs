@@ -188,6 +188,14 @@ enum Cmd {
         #[arg(default_value = "../../shared/datasets")]
         datasets: PathBuf,
     },
+    /// What moves the ZUPT stride's bias between set-ups (the lever arm, the clock, the
+    /// accelerometer's gain and offset, the unit of length), the lever arm the strides give,
+    /// and the bias by dataset × mounting × pace before and after (docs/accuracy.md).
+    Bias {
+        /// The folder holding the datasets (`../shared/datasets`).
+        #[arg(default_value = "../../shared/datasets")]
+        datasets: PathBuf,
+    },
     /// Time the core's toe-offs and heel-strikes against `gaitmap_walk`'s mocap events and
     /// `ipol_gait_events`' annotations, beside the same events read from the foot's sagittal
     /// angular rate (docs/accuracy.md's event timing table).
@@ -666,6 +674,9 @@ fn run(cli: Cli) -> anyhow::Result<()> {
         }
         Cmd::ZuptSweep { datasets } => {
             print!("{}", gaitclip_host::eval::zupt_sweep::report(&datasets)?);
+        }
+        Cmd::Bias { datasets } => {
+            print!("{}", gaitclip_host::eval::bias::report(&datasets)?);
         }
         Cmd::Events { datasets } => {
             print!("{}", gaitclip_host::eval::event_timing::report(&datasets)?);

@@ -32,6 +32,7 @@ pub const GENERATORS: &[(&str, Generator)] = &[
     ("rates", crate::eval::rate_sweep::report),
     ("running", crate::eval::running::report),
     ("flags", crate::eval::flag_costs::report),
+    ("bias", crate::eval::bias::report),
 ];
 
 /// The subcommands of the `gaitclip` binary a marker may run as a whole command line: the

@@ -399,6 +399,17 @@ pub fn three_ways_table(by: &[(Validation, Vec<DatasetScores>)]) -> String {
     t.render()
 }
 
+/// A bin's label in every table: `< hi`, `lo–hi` or `> lo`, with the unit.
+pub fn bin_label((lo, hi): (f64, f64), unit: &str) -> String {
+    if hi.is_infinite() {
+        format!("> {lo} {unit}")
+    } else if lo == 0.0 {
+        format!("< {hi} {unit}")
+    } else {
+        format!("{lo}–{hi} {unit}")
+    }
+}
+
 /// RMSE / bias (cm) per speed or length bin, one row per model, a column per dataset (with
 /// per-stride lengths) and bin, and the pooled distance error of each bin's strides.
 pub fn binned_table(scores: &[DatasetScores], by: BinBy) -> String {
@@ -410,15 +421,7 @@ pub fn binned_table(scores: &[DatasetScores], by: BinBy) -> String {
         BinBy::Speed => "m/s",
         BinBy::Length => "m",
     };
-    let label = |&(lo, hi): &(f64, f64)| {
-        if hi.is_infinite() {
-            format!("> {lo} {unit}")
-        } else if lo == 0.0 {
-            format!("< {hi} {unit}")
-        } else {
-            format!("{lo}–{hi} {unit}")
-        }
-    };
+    let label = |&bin: &(f64, f64)| bin_label(bin, unit);
     let with: Vec<&DatasetScores> = scores.iter().filter(|(_, s)| s[0].strides > 0).collect();
     let mut header = vec!["model".to_string()];
     for (d, sc) in &with {

@@ -1,5 +1,6 @@
 //! Scoring against ground truth, and the tables and pages it writes.
 
+pub mod bias;
 pub mod clip_sweep;
 pub mod docs;
 pub mod event_timing;

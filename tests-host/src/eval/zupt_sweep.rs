@@ -19,16 +19,14 @@ use std::fmt::Write as _;
 use std::path::Path;
 
 use anyhow::Result;
-use gaitclip::length::models::Model;
-use gaitclip::record::stride::StrideFlags;
 use gaitclip::sensor::sample::{AccelRange, GyroRange};
 
+use crate::eval::bias;
 use crate::eval::length_eval::SPEED_BINS;
 use crate::eval::markdown::Table;
-use crate::eval::matching::{self, Detected, Scored};
+use crate::io::csv_trace;
 use crate::io::datasets;
 use crate::io::trace::Ranges;
-use crate::{io::csv_trace, replay};
 
 /// Sensor heights swept, mm.
 pub const HEIGHTS_MM: [u32; 6] = [0, 40, 60, 80, 100, 120];
@@ -45,39 +43,12 @@ fn errors(
     let mut out = Vec::new();
     for trial in &dataset.trials {
         let t = csv_trace::read(&trial.csv, Some(dataset.rate_hz))?;
-        let p = replay::prepare(&t, ranges)?;
-        let mut c = p.config(ranges);
-        c.model = Model::Zupt;
-        c.sensor_height_um = height_um;
-        let strides = p.strides(c);
-        let det: Vec<Detected> = strides.iter().map(Detected::from).collect();
-        let refs = trial.references_in_numbers(&p.clock);
-        let rate = p.clock.rate_hz();
-        let scored = matching::classify(trial, &p.clock, &det, &refs);
-        // As training scores: a reference holding a movement its borders leave out measured
-        // two movements, and no stride is compared with it.
-        let holds_two = |r: &datasets::Reference| {
-            det.iter().zip(&scored).any(|(d, c)| {
-                *c == Scored::Unbordered
-                    && 2 * (d.events.foot_flat.min(r.end))
-                        .saturating_sub(d.events.heel_off.max(r.start))
-                        >= d.events.foot_flat - d.events.heel_off
-            })
-        };
-        for (i, c) in scored.iter().enumerate() {
-            let Scored::Found(j) = *c else { continue };
-            let (s, r) = (&strides[i], &refs[j]);
-            if !s.flags.valid() || holds_two(r) {
-                continue;
-            }
-            let Some(len) = r.length_m else { continue };
-            let speed = len / ((r.end - r.start) as f64 / rate);
-            out.push((
-                speed,
-                s.zupt_um as f64 / 1e6 - len,
-                s.flags.has(StrideFlags::GYRO_CLIPPED),
-            ));
-        }
+        let run = bias::run_trial(trial, &t, ranges, &|c| c.sensor_height_um = height_um)?;
+        out.extend(
+            run.strides
+                .iter()
+                .map(|e| (e.speed_mps, e.error_m, e.gyro_clipped)),
+        );
     }
     Ok(out)
 }
@@ -100,15 +71,7 @@ pub fn report(root: &Path) -> Result<String> {
         .iter()
         .map(|n| datasets::load(&root.join(n)))
         .collect::<Result<_>>()?;
-    let bin_name = |(lo, hi): (f64, f64)| {
-        if hi.is_infinite() {
-            format!("> {lo} m/s")
-        } else if lo == 0.0 {
-            format!("< {hi} m/s")
-        } else {
-            format!("{lo}–{hi} m/s")
-        }
-    };
+    let bin_name = |bin: (f64, f64)| crate::eval::length_eval::bin_label(bin, "m/s");
     writeln!(
         s,
         "ZUPT stride by sensor height above the rolling contact (cycle detector, ±2000 °/s; RMSE / bias cm (strides)):\n"

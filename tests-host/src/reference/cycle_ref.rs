@@ -12,6 +12,7 @@
 
 use gaitclip::detect::clipping::SHAPED_RUN_MIN;
 use gaitclip::detect::cycle::{Calibration, CycleConfig, SIGMA_A_MMPS2, SIGMA_W_MRADPS};
+use gaitclip::detect::zupt::{GravityReading, MAX_GRAVITY_OFFSET_MILLI_G};
 use gaitclip::pipeline::config::Config;
 use gaitclip::pipeline::Pipeline;
 use gaitclip::record::stride::{Stride, StrideFlags};
@@ -145,7 +146,7 @@ pub fn zupt_m(run: &CoreRun, k: usize) -> Result<f64, Skipped> {
     let dt = 1e3 / config.rate.millihertz() as f64;
     let rad = rad_per_count(config);
     let h_m = config.sensor_height_um as f64 / 1e6;
-    let g_counts = cal0.gravity_counts as f64;
+    let (offset, g_counts, unit) = reading_terms(config, cal0.gravity_counts as f64, &up0);
     let omega = |x: &RawSample, b: [i32; 3]| {
         Vector3::new(
             (x.gyro[0] as f64 - b[0] as f64) * rad,
@@ -172,7 +173,7 @@ pub fn zupt_m(run: &CoreRun, k: usize) -> Result<f64, Skipped> {
     let mut steps: Vec<(Vector3<f64>, f64)> = Vec::new();
     let mut singles: Vec<(Vector3<f64>, f64)> = Vec::new();
     let (mut min_rail, mut climbs) = (f64::INFINITY, 0f64);
-    let to_mps = G / g_counts * dt;
+    let to_mps = G / unit * dt;
     let mut book = |k: usize,
                     (len, area, climb): Done,
                     (dir, first): (Vector3<f64>, f64),
@@ -191,8 +192,9 @@ pub fn zupt_m(run: &CoreRun, k: usize) -> Result<f64, Skipped> {
     for (c, i) in (i0 + 1..=i1).enumerate() {
         let x = sample(i)?;
         q *= UnitQuaternion::from_scaled_axis(omega(&x, cal0.gyro_bias) * dt);
-        let f = q * Vector3::new(x.accel[0] as f64, x.accel[1] as f64, x.accel[2] as f64);
-        let a = (f - Vector3::new(0.0, 0.0, g_counts)) * (G / g_counts);
+        let f =
+            q * (Vector3::new(x.accel[0] as f64, x.accel[1] as f64, x.accel[2] as f64) - offset);
+        let a = (f - Vector3::new(0.0, 0.0, g_counts)) * (G / unit);
         let v_prev = v;
         v += a * dt;
         p += (v_prev + v) * (dt / 2.0);
@@ -266,8 +268,10 @@ pub fn zupt_m(run: &CoreRun, k: usize) -> Result<f64, Skipped> {
                 level.xy() / norm
             };
             let w = n * s1 - s2;
-            p.x += h.x * w / clipped as f64 * G * dt * dt / 2.0;
-            p.y += h.y * w / clipped as f64 * G * dt * dt / 2.0;
+            // The leak of the gravity the sensor reads, in metres of the unit.
+            let leak = G * g_counts / unit;
+            p.x += h.x * w / clipped as f64 * leak * dt * dt / 2.0;
+            p.y += h.y * w / clipped as f64 * leak * dt * dt / 2.0;
         }
     }
     Ok(p.xy().norm())
@@ -367,6 +371,23 @@ impl RailRunF64 {
     }
 }
 
+/// What the core makes of the rest's gravity `g_counts` (counts) with the stance's
+/// up `up` (sensor axes, any scale), as [`gaitclip::detect::zupt::GravityReading`] says: the
+/// offset removed from every sample (counts), the gravity removed from the levelled force
+/// (counts) and the counts of 1 g in metres.
+fn reading_terms(config: &Config, g_counts: f64, up: &Vector3<f64>) -> (Vector3<f64>, f64, f64) {
+    let nominal = config.accel.lsb_per_g() as f64;
+    match config.gravity_reading {
+        GravityReading::Offset => {
+            let bound = nominal * MAX_GRAVITY_OFFSET_MILLI_G as f64 / 1000.0;
+            let d = (g_counts - nominal).clamp(-bound, bound);
+            (up.normalize() * d, g_counts - d, nominal)
+        }
+        GravityReading::Ignored => (Vector3::zeros(), g_counts, nominal),
+        GravityReading::Gain => (Vector3::zeros(), g_counts, g_counts),
+    }
+}
+
 /// The cycle detector's constants for `config` (its phases and sensor height).
 pub fn cycle_config(config: &Config) -> CycleConfig {
     CycleConfig::new(
@@ -377,4 +398,92 @@ pub fn cycle_config(config: &Config) -> CycleConfig {
         config.phases,
         config.sensor_height_um,
     )
+}
+
+/// What a stride's end says about the lever arm of the rolling contact
+/// ([`end_residual`]): in the level frame of its start, horizontal components.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct EndResidual {
+    /// The end velocity integrated from zero at the start instant (h = 0), m/s: the
+    /// residual a plain zero-velocity update leaves.
+    pub r: [f64; 2],
+    /// The rolling contact's velocity per metre of h at the start instant, `ω × up`, m/s per m.
+    pub u0: [f64; 2],
+    /// The same at the end instant.
+    pub u1: [f64; 2],
+}
+
+/// The end residual of stride `k` of `run` in `f64`, for a lever-arm fit: with the sensor
+/// `h` above the contact the sensor moves at `h·u` at each instant, so the residual of the
+/// integration from zero is `h·(u₁ − u₀)` plus the integration's own error. Strides that
+/// clipped are skipped (their restoration is not modelled here).
+pub fn end_residual(run: &CoreRun, k: usize) -> Result<EndResidual, Skipped> {
+    let s = &run.strides[k];
+    if !s.flags.valid()
+        || s.flags.has(StrideFlags::BRIDGED)
+        || s.flags.has(StrideFlags::GYRO_CLIPPED)
+        || s.flags.has(StrideFlags::ACCEL_CLIPPED)
+    {
+        return Err(Skipped::Flagged);
+    }
+    let prev = k
+        .checked_sub(1)
+        .map(|j| &run.strides[j])
+        .filter(|p| p.events.end == s.events.start)
+        .ok_or(Skipped::NoPrevious)?;
+    let (i0, i1) = (s.events.start as usize, s.events.end as usize);
+    let low0 = prev.events.foot_flat as usize;
+    if i0 - low0 >= 1 << 16 {
+        return Err(Skipped::LongRest);
+    }
+    let sample = |i: usize| {
+        run.samples
+            .get(i)
+            .copied()
+            .flatten()
+            .ok_or(Skipped::Missing)
+    };
+    let cal = |i: usize| {
+        run.calibration
+            .get(i)
+            .copied()
+            .flatten()
+            .ok_or(Skipped::Missing)
+    };
+    let (cal0, cal1) = (cal(i0)?, cal(i1)?);
+    let mut up0 = Vector3::zeros();
+    for i in low0..=i0 {
+        let x = sample(i)?;
+        up0 += Vector3::new(x.accel[0] as f64, x.accel[1] as f64, x.accel[2] as f64);
+    }
+    let config = &run.config;
+    let dt = 1e3 / config.rate.millihertz() as f64;
+    let rad = rad_per_count(config);
+    let (offset, g_counts, unit) = reading_terms(config, cal0.gravity_counts as f64, &up0);
+    let omega = |x: &RawSample, b: [i32; 3]| {
+        Vector3::new(
+            (x.gyro[0] as f64 - b[0] as f64) * rad,
+            (x.gyro[1] as f64 - b[1] as f64) * rad,
+            (x.gyro[2] as f64 - b[2] as f64) * rad,
+        )
+    };
+    let per_metre = |q: &UnitQuaternion<f64>, w: Vector3<f64>| {
+        let wl = q * w;
+        [wl.y, -wl.x]
+    };
+    let mut q = UnitQuaternion::rotation_between(&up0, &Vector3::z()).ok_or(Skipped::Missing)?;
+    let u0 = per_metre(&q, omega(&sample(i0)?, cal0.gyro_bias));
+    let mut v = Vector3::zeros();
+    for i in i0 + 1..=i1 {
+        let x = sample(i)?;
+        q *= UnitQuaternion::from_scaled_axis(omega(&x, cal0.gyro_bias) * dt);
+        let f =
+            q * (Vector3::new(x.accel[0] as f64, x.accel[1] as f64, x.accel[2] as f64) - offset);
+        v += (f - Vector3::new(0.0, 0.0, g_counts)) * (G / unit) * dt;
+    }
+    Ok(EndResidual {
+        r: [v.x, v.y],
+        u0,
+        u1: per_metre(&q, omega(&sample(i1)?, cal1.gyro_bias)),
+    })
 }
