@@ -48,6 +48,7 @@
 use heapless::Vec;
 
 use crate::detect::foot_frame::FootFrameEstimator;
+use crate::detect::gyro_events;
 use crate::detect::phase_stats::{StrideStats, CHANNELS};
 use crate::detect::phases::{self, PhaseMethod};
 use crate::detect::seam::MAX_STANCE_IN_STRIDE_MS;
@@ -92,6 +93,13 @@ pub const FLAT_MAX_DEG: u32 = 60;
 /// sits ≈ 4–6 cm above it, one on the laces ≈ 8–10 cm; measured: docs/accuracy.md (`gaitclip zupt-sweep`).
 pub const SENSOR_HEIGHT_UM: u32 = 80_000;
 
+/// Columns of the movement buffer: Huang's [`CHANNELS`] and the sagittal rate
+/// ([`SAGITTAL_RATE_COLUMN`]).
+pub const MOVEMENT_COLUMNS: usize = CHANNELS + 1;
+/// The movement buffer's column of the sagittal angular rate (gyro counts about the foot's
+/// pitch axis, either sign), for [`gyro_events`].
+pub const SAGITTAL_RATE_COLUMN: usize = CHANNELS;
+
 /// cos²(45°) and cos²(60°) in Q30.
 const COS2_45_Q30: i128 = 1 << 29;
 const COS2_60_Q30: i128 = 1 << 28;
@@ -133,6 +141,8 @@ pub struct CycleConfig {
     pub rails: Rails,
     /// Whether the accelerometer's loss at its rails is put back ([`Config::restore_accel`](crate::pipeline::config::Config::restore_accel)).
     pub restore_accel: bool,
+    /// [`gyro_events::SWING_MIN_MRADPS`] in gyro counts.
+    swing_min: i16,
 }
 
 impl CycleConfig {
@@ -181,6 +191,14 @@ impl CycleConfig {
             integrator: ZuptIntegrator::new(rate, accel, gyro),
             rails,
             restore_accel: true,
+            swing_min: {
+                let c = gyro.counts_of_mrad_per_s(gyro_events::SWING_MIN_MRADPS);
+                if c > i16::MAX as u32 {
+                    i16::MAX
+                } else {
+                    c as i16
+                }
+            },
         }
     }
 
@@ -214,6 +232,10 @@ pub struct Calibration {
     pub gravity_counts: i32,
     /// The foot's standing up, any scale, sensor axes (counts of the rest's mean force).
     pub up: [i32; 3],
+    /// The axis the foot pitches about in its steps, a unit row in sensor axes, Q14, any sign
+    /// ([`crate::detect::foot_frame::FootFrame::pitch_axis_q14`]); `None` before the first
+    /// step was learnt from.
+    pub pitch: Option<[i32; 3]>,
 }
 
 impl Calibration {
@@ -231,6 +253,7 @@ impl Calibration {
             gyro_bias,
             gravity_counts,
             up: f.up_row(),
+            pitch: f.pitch_axis_q14(),
         })
     }
 }
@@ -310,10 +333,10 @@ pub struct CycleDetector<const M: usize> {
     low_n: u32,
     low_start: u32,
     in_low: bool,
-    /// Movement buffer: `[vertical, sagittal, |f| − g]` from the stride's heel-off
-    /// (`movement[0]` is sample `mv_origin`), less the samples of a slow swing's dip that
-    /// were taken for a stance (`mv_gap`: buffer position and samples skipped there).
-    movement: Vec<[i16; CHANNELS], M>,
+    /// Movement buffer: `[vertical, sagittal, |f| − g, sagittal rate]` from the stride's
+    /// heel-off (`movement[0]` is sample `mv_origin`), less the samples of a slow swing's dip
+    /// that were taken for a stance (`mv_gap`: buffer position and samples skipped there).
+    movement: Vec<[i16; MOVEMENT_COLUMNS], M>,
     /// Samples of a movement kept ([`crate::detect::seam::MAX_MOVEMENT_MS`] at the rate, at most
     /// `M`).
     max_movement: usize,
@@ -329,6 +352,9 @@ pub struct CycleDetector<const M: usize> {
     /// A stride released while filling a hole with no call to report it from.
     held: Option<Stride>,
     dropped: u32,
+    /// The foot's pitch axis was known when the last sample was decided on: the sagittal
+    /// rate in the buffer is about it.
+    axis_known: bool,
 }
 
 /// The window sum's threshold for a per-sample energy in Q16.
@@ -390,6 +416,7 @@ impl<const M: usize> CycleDetector<M> {
             ],
             held: None,
             dropped: 0,
+            axis_known: false,
         }
     }
 
@@ -497,6 +524,7 @@ impl<const M: usize> CycleDetector<M> {
         out: &mut Option<Stride>,
     ) {
         self.last_at = i;
+        self.axis_known = cal.pitch.is_some();
         // Not `let cfg = self.cfg`: the config holds an integrator, and this runs per sample.
         let (confirm_after, max_stance) = (self.cfg.confirm, self.cfg.max_stance);
         let w = self.window();
@@ -558,9 +586,12 @@ impl<const M: usize> CycleDetector<M> {
         let moving = self.cur.as_ref().is_some_and(|c| c.heel_off.is_some());
         if moving && self.movement.len() < self.max_movement {
             // Full: what is lost is counted when the stride closes (too long).
-            let _ = self
-                .movement
-                .push([foot.up(), foot.forward(), foot.magnitude_minus_g()]);
+            let _ = self.movement.push([
+                foot.up(),
+                foot.forward(),
+                foot.magnitude_minus_g(),
+                cal.pitch.map_or(0, |axis| sagittal_rate(&axis, &omega)),
+            ]);
         }
         self.peak = self.peak.max(t);
         self.peak_since_cand = self.peak_since_cand.max(t);
@@ -870,6 +901,7 @@ impl<const M: usize> CycleDetector<M> {
             mv_gap,
             next_index,
             stats,
+            axis_known,
             ..
         } = self;
         let (Some(cur), Some(c)) = (cur.as_ref(), cand.as_ref()) else {
@@ -894,14 +926,27 @@ impl<const M: usize> CycleDetector<M> {
         let heel_off = cur.heel_off.unwrap_or(foot_flat).max(cur.start);
         let index = *next_index;
         *next_index = next_index.wrapping_add(1);
-        // The statistics go straight into their slot (≈ 400 B, not through the stack).
+        // The statistics go straight into their slot (≈ 400 B, not through the stack): Huang's
+        // phases, which his per-phase features are defined on. The events reported are the
+        // sagittal rate's where it has them ([`gyro_events`]), Huang's boundaries where not:
+        // before the pitch axis is learnt, and where the buffer skipped a slow swing's dip
+        // (`mv_gap`: the swing's rate is then cut, and its size no longer tells it from the
+        // push-off; measured on `ipol_gait_events`, reading the rate there anyway put 13 more
+        // events over 100 ms from the annotations).
         let (toe_off, heel_strike, found) = {
             let movement = &movement[..len];
             let split = phases::split(movement, cfg.phases, cfg.merge);
             let slot = &mut stats[(index & 1) as usize];
             slot.0 = index;
             slot.1 = StrideStats::measure(movement, split.toe_off, split.heel_strike);
-            (split.toe_off, split.heel_strike, split.found)
+            let gyro = match *axis_known && mv_gap.is_none() {
+                true => gyro_events::find(movement, SAGITTAL_RATE_COLUMN, cfg.swing_min),
+                false => None,
+            };
+            match gyro {
+                Some(e) => (e.toe_off, e.heel_strike, true),
+                None => (split.toe_off, split.heel_strike, split.found),
+            }
         };
         if !found {
             flags |= StrideFlags::PHASES_GUESSED;
@@ -989,6 +1034,18 @@ fn mark(flags: &mut u16, s: &RawSample, rails: &Rails, origin: Origin, moving: b
         (Origin::Filled, true) => *flags |= StrideFlags::GAP,
         _ => *flags |= StrideFlags::BRIDGED,
     }
+}
+
+/// The angular rate `omega` (counts, bias removed) about the unit axis `axis` (Q14),
+/// counts, saturated to ±32 767: `|axis| = 2¹⁴` and `|ω| < 2¹⁶` keep each product under
+/// 2³¹ and the sum in an `i64`; within 1 count of the exact projection.
+fn sagittal_rate(axis: &[i32; 3], omega: &[i32; 3]) -> i16 {
+    let dot: i64 = axis
+        .iter()
+        .zip(omega.iter())
+        .map(|(&l, &w)| l as i64 * w as i64)
+        .sum();
+    ((dot + (1 << 13)) >> 14).clamp(-32_767, 32_767) as i16
 }
 
 /// Gravity `mean` (counts·2⁸) within [`FLAT_MAX_DEG`] of the standing up `up`.

@@ -71,6 +71,8 @@ pub struct FootFrame {
     gravity: i32,
     /// The forward axis was learnt from movements (not a placeholder perpendicular to up).
     heading_known: bool,
+    /// The steps' rotation axis, unit Q14 in sensor axes, once learnt.
+    pitch: Option<[i32; 3]>,
 }
 
 impl FootFrame {
@@ -107,6 +109,13 @@ impl FootFrame {
     /// foot's standing up, for a direction test.
     pub const fn up_row(&self) -> [i32; 3] {
         self.rows[2]
+    }
+
+    /// The axis the foot pitches about in its steps as a unit row in sensor axes, Q14, any
+    /// sign ([`FootFrameEstimator`]: the steps' principal rotation axis, not projected on the
+    /// horizontal); `None` before a step has been learnt from.
+    pub const fn pitch_axis_q14(&self) -> Option<[i32; 3]> {
+        self.pitch
     }
 
     /// Gravity measured at rest, in g/2048.
@@ -151,6 +160,10 @@ pub struct FootFrameEstimator {
     up: [f32; 3],
     gravity_counts: f32,
     left_sum: [f32; 3],
+    /// The steps' principal rotation axes, summed as `left_sum` is but not projected on the
+    /// horizontal, each signed to agree with the sum so far (the rate's events take their
+    /// sign from each movement, [`crate::detect::gyro_events`]).
+    pitch_sum: [f32; 3],
     heading_known: bool,
     was_rest: bool,
     rest: RestSums,
@@ -180,6 +193,7 @@ impl FootFrameEstimator {
             up: [0.0; 3],
             gravity_counts: 0.0,
             left_sum: [0.0; 3],
+            pitch_sum: [0.0; 3],
             heading_known: false,
             was_rest: false,
             rest: RestSums::new(),
@@ -365,6 +379,7 @@ impl FootFrameEstimator {
             self.up = u.into();
             self.gravity_counts = g;
             self.left_sum = [0.0; 3];
+            self.pitch_sum = [0.0; 3];
             self.heading_known = false;
         } else {
             let blended = up * (1.0 - UP_SMOOTHING) + u * UP_SMOOTHING;
@@ -405,6 +420,9 @@ impl FootFrameEstimator {
         let left = horizontal.normalize() * sign;
         let sum = Vector3::from(self.left_sum) * AXIS_MEMORY + left;
         self.left_sum = sum.into();
+        let pitch = Vector3::from(self.pitch_sum);
+        let along = if axis.dot(&pitch) < 0.0 { -1.0 } else { 1.0 };
+        self.pitch_sum = (pitch * AXIS_MEMORY + axis * along).into();
         self.heading_known = true;
         self.rebuild();
     }
@@ -431,10 +449,16 @@ impl FootFrameEstimator {
         let row = |v: Vector3<f32>| [0, 1, 2].map(|i| libm_round(v[i] * scale));
         let gravity =
             libm_round(self.gravity_counts * FOOT_LSB_PER_G as f32 / self.accel.lsb_per_g() as f32);
+        let pitch = Vector3::from(self.pitch_sum);
+        let pitch = (pitch.norm() > 1e-3).then(|| {
+            let unit = pitch.normalize();
+            [0, 1, 2].map(|i| libm_round(unit[i] * (1u32 << 14) as f32))
+        });
         self.frame = Some(FootFrame {
             rows: [row(forward), row(left), row(up)],
             gravity,
             heading_known: self.heading_known,
+            pitch,
         });
     }
 }

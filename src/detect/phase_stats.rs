@@ -102,7 +102,8 @@ pub struct SegmentStats {
 }
 
 impl SegmentStats {
-    fn add(&mut self, x: &[i16; CHANNELS]) {
+    /// Adds a sample's first [`CHANNELS`] columns.
+    fn add<const N: usize>(&mut self, x: &[i16; N]) {
         let first = self.samples == 0;
         self.samples = self.samples.saturating_add(1);
         for (c, &v) in self.channels.iter_mut().zip(x.iter()) {
@@ -146,12 +147,13 @@ impl StrideStats {
         }
     };
 
-    /// Summarises `movement` (`[vertical, sagittal, magnitude]` per sample) split at the
-    /// offsets `toe_off` and `heel_strike` (clamped to the movement, in order).
+    /// Summarises `movement` (`[vertical, sagittal, magnitude, …]` per sample; columns after
+    /// the [`CHANNELS`] are not summed) split at the offsets `toe_off` and `heel_strike`
+    /// (clamped to the movement, in order).
     // Not inlined (nor are the splitter and the stride closing): each keeps its
     // temporaries on the stack only while it runs, which a 16 KiB Cortex-M0 needs.
     #[inline(never)]
-    pub fn measure(movement: &[[i16; CHANNELS]], toe_off: u32, heel_strike: u32) -> Self {
+    pub fn measure<const N: usize>(movement: &[[i16; N]], toe_off: u32, heel_strike: u32) -> Self {
         let len = movement.len();
         let to = (toe_off as usize).min(len);
         let hs = (heel_strike as usize).clamp(to, len);

@@ -111,7 +111,9 @@ fn replay_finds_simulated_strides() {
 }
 
 /// The pipeline's whole state is a compile-time size: with the boards' movement buffer (5.12 s
-/// at 200 Hz) under 16 KiB.
+/// at 200 Hz) under 17 KiB (16 416 B since the buffer keeps the sagittal rate beside the
+/// accelerations, 2 B a sample; the boards that buffer 5.12 s have 64 KiB of RAM or more, the
+/// micro:bit buffers 1.28 s).
 #[test]
 fn pipeline_state_is_bounded() {
     const M: usize = gaitclip::detect::seam::movement_samples(200);
@@ -119,5 +121,5 @@ fn pipeline_state_is_bounded() {
         gaitclip::pipeline::Pipeline<gaitclip::pipeline::detectors::AnyDetector<M>>,
     >();
     eprintln!("Pipeline state: {bytes} bytes");
-    assert!(bytes < 16 * 1024, "{bytes}");
+    assert!(bytes < 17 * 1024, "{bytes}");
 }

@@ -44,7 +44,7 @@ fn an_800_hz_run_and_its_decimations_give_the_same_strides() {
 
 /// On `pyshoe_vicon` the ZUPT stride stays unbiased up to 3 m/s (measured −0.1 … −0.7 cm by
 /// bin), the instant is a near-still moment of the foot (marker median ≤ 0.13 m/s), and the
-/// duty factor calls most strides above 2 m/s running and few under 1.5 m/s.
+/// duty factor calls nearly every stride above 2 m/s running and few under 1 m/s.
 #[test]
 fn the_stance_instant_holds_up_to_running_speed() {
     let Some(root) = root_or_skip("the_stance_instant_holds_up_to_running_speed") else {
@@ -72,6 +72,9 @@ fn the_stance_instant_holds_up_to_running_speed() {
     }
     let share =
         |b: &[&running::Instant]| b.iter().filter(|x| x.running).count() as f64 / b.len() as f64;
-    assert!(share(&bin(2.0, 10.0)) >= 0.6, "{}", share(&bin(2.0, 10.0)));
-    assert!(share(&bin(0.0, 1.5)) <= 0.1, "{}", share(&bin(0.0, 1.5)));
+    // Measured 98 % over 2 m/s and 3 % under 1 m/s. Between 1 and 1.5 m/s (21 %) the room's
+    // slow jogs, at 140–160 steps/min, are runs: the cadence classes of `gait_parameters.rs`
+    // judge those.
+    assert!(share(&bin(2.0, 10.0)) >= 0.9, "{}", share(&bin(2.0, 10.0)));
+    assert!(share(&bin(0.0, 1.0)) <= 0.05, "{}", share(&bin(0.0, 1.0)));
 }

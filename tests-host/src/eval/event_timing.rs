@@ -1,12 +1,12 @@
 //! `gaitclip events`: when the core's toe-off and heel-strike fall against the references,
-//! beside the same events defined on the foot's sagittal angular rate, to find out which
-//! definition each reference follows (and so why the core's events come late).
+//! beside the same events defined on the foot's sagittal angular rate in `f64` on the host,
+//! to show which definition each reference follows.
 //!
-//! The core's events are Huang et al. 2022's phase boundaries ([`gaitclip::detect::phases`]):
-//! toe-off the mean of the push-off's sagittal acceleration peak and vertical valley,
-//! heel-strike the mean of the impact's two acceleration peaks. The candidates here are read
-//! from the gyro alone, in f64 on the host, inside each matched stride's movement (heel-off
-//! − 50 ms to foot-flat + 150 ms):
+//! The core's events are the sagittal rate's ([`gaitclip::detect::gyro_events`]: the push-off
+//! peak, the zero crossing that ends the swing), or Huang et al. 2022's phase boundaries
+//! ([`gaitclip::detect::phases`]) where the rate gives none. The candidates here are read from
+//! the gyro alone inside each matched stride's movement (heel-off − 50 ms to foot-flat +
+//! 150 ms), independently of the core's:
 //!
 //! - **sagittal rate**: the gyro projected on its principal axis over the trial's moving
 //!   samples (|ω| above a third of its 95th percentile; the foot rotates mostly about its
@@ -277,18 +277,22 @@ pub fn report(root: &Path) -> Result<String> {
         let d = evaluate(&datasets::load(&root.join(name))?)?;
         type Pick = fn(&EventErrors) -> Option<f64>;
         let rows: [(&str, &str, Pick); 6] = [
-            ("toe-off", "core (Huang's acceleration pair)", |e| {
-                Some(e.toe_off_core)
-            }),
+            (
+                "toe-off",
+                "core (the sagittal rate; Huang's pair where it has none)",
+                |e| Some(e.toe_off_core),
+            ),
             ("toe-off", "sagittal rate: push-off peak", |e| {
                 e.toe_off_peak
             }),
             ("toe-off", "sagittal rate: zero crossing (Rampp)", |e| {
                 e.toe_off_crossing
             }),
-            ("heel-strike", "core (Huang's acceleration pair)", |e| {
-                Some(e.heel_strike_core)
-            }),
+            (
+                "heel-strike",
+                "core (the sagittal rate; Huang's pair where it has none)",
+                |e| Some(e.heel_strike_core),
+            ),
             ("heel-strike", "sagittal rate: zero crossing", |e| {
                 e.heel_strike_crossing
             }),
