@@ -15,10 +15,23 @@
 //! variability on walks full of turns; matching the cadence (the velocity of kept strides
 //! within 25 % of the duration, times the duration) or taking the last one, the median of
 //! three or the velocity of three were no better on all three (+6.6 cm bias on IPOL for the
-//! cadence match). A hole that swallowed a stance instant makes one "stride" of two cycles:
-//! one stride is what is known of it. With no measured stride yet (a hole before the first)
-//! there is nothing to estimate from: the stride keeps its flags, no length, and the host
-//! counts it as unestimated.
+//! cadence match).
+//!
+//! **A stride of more cycles than one.** A cluster of holes that swallowed a stance instant
+//! (or a movement beyond its buffer) makes one "stride" of two cycles or more, and one
+//! stride's length would drop the others from the distance: the estimate is the mean length
+//! times the cycles the stride lasted, its duration over the mean duration of the kept
+//! strides with a quarter cycle's slack (`⌊d/d̄ + ¼⌋`: two cycles from 1.75 of them, so that a
+//! slow single stride stays one; [`MAX_CYCLES`] at most). A stride from or into a rest holds
+//! standing, and counts one; so does a movement longer than its buffer (standing or fiddling
+//! inside it, not cycles: a hole cut into the demo walk's stand made one of 4.9 s). Any other
+//! lasts whole cycles: a stand long enough to break the count restarts detection (a hole
+//! longer than [`crate::pipeline::config::FILL_MAX_MS`]) or is seen as a rest. Found on `ipol_gait_events` (`17-2_right`: 2.5 s of a dense hole cluster
+//! around the U-turn, two steps, estimated as one; now as two, +1.65 m, the only stride of the
+//! four datasets whose estimate changed).
+//!
+//! With no measured stride yet (a hole before the first) there is nothing to estimate from:
+//! the stride keeps its flags, no length, and the host counts it as unestimated.
 //!
 //! What each flag's estimate costs against the stride's measured length is measured by
 //! cutting holes into real recordings (`gaitclip flags`, `docs/`).
@@ -29,6 +42,9 @@ use crate::record::stride::{Stride, StrideFlags, MAX_STRIDE_MM};
 
 /// Measured strides the estimate is the mean of.
 pub const HISTORY: usize = 2;
+/// The most cycles one estimated stride is taken to span (a movement buffer holds 5.12 s,
+/// four slow cycles).
+pub const MAX_CYCLES: u32 = 4;
 
 /// Flags under which a valid stride is not one gait cycle at the walker's pace, and teaches
 /// the estimate nothing.
@@ -39,6 +55,8 @@ const NOT_A_CYCLE: u16 = StrideFlags::FROM_REST | StrideFlags::TO_REST | StrideF
 pub struct LengthEstimator {
     /// Lengths, mm, of the kept strides (ring, newest at `(next − 1) mod HISTORY`).
     length_mm: [u32; HISTORY],
+    /// Their durations, samples.
+    duration: [u32; HISTORY],
     kept: u8,
     next: u8,
 }
@@ -54,6 +72,7 @@ impl LengthEstimator {
     pub const fn new() -> Self {
         LengthEstimator {
             length_mm: [0; HISTORY],
+            duration: [0; HISTORY],
             kept: 0,
             next: 0,
         }
@@ -76,6 +95,7 @@ impl LengthEstimator {
             if s.flags.0 & NOT_A_CYCLE == 0 && s.length_mm > 0 {
                 let at = self.next as usize;
                 self.length_mm[at] = s.length_mm;
+                self.duration[at] = duration;
                 self.next = ((at + 1) % HISTORY) as u8;
                 if (self.kept as usize) < HISTORY {
                     self.kept += 1;
@@ -84,9 +104,27 @@ impl LengthEstimator {
             return;
         }
         if let Some(mm) = self.estimate_mm() {
-            s.length_mm = mm.min(MAX_STRIDE_MM);
+            let within = StrideFlags::FROM_REST | StrideFlags::TO_REST | StrideFlags::TOO_LONG;
+            let k = match s.flags.0 & within {
+                0 => self.cycles_in(duration),
+                _ => 1,
+            };
+            s.length_mm = (mm.min(MAX_STRIDE_MM) as u64 * k as u64) as u32;
             s.flags.0 |= StrideFlags::ESTIMATED;
         }
+    }
+
+    /// The cycles a stride of `duration` samples spans: `⌊duration / mean + ¼⌋` over the kept
+    /// strides' mean duration, from 1 to [`MAX_CYCLES`] (1 with none kept).
+    pub fn cycles_in(&self, duration: u32) -> u32 {
+        let n = self.kept as usize;
+        let total: u64 = self.duration[..n].iter().map(|&d| d as u64).sum();
+        if total == 0 {
+            return 1;
+        }
+        // ⌊duration / (total / n) + ¼⌋ = ⌊(4·duration·n + total) / (4·total)⌋.
+        let k = (4 * duration as u64 * n as u64 + total) / (4 * total);
+        k.clamp(1, MAX_CYCLES as u64) as u32
     }
 
     /// The estimated length, mm: the mean of the kept strides; `None` with none kept.

@@ -65,6 +65,34 @@ fn an_unmeasured_stride_gets_the_mean_of_the_last_two_measured_cycles() {
     assert_eq!(z.length_mm, 0);
 }
 
+#[test]
+fn an_unmeasured_stride_of_two_cycles_counts_two() {
+    let mut e = LengthEstimator::new();
+    // Two measured cycles of 200 and 220 samples (mean 210), 1300 and 1400 mm (mean 1350).
+    e.process(&mut stride(0, 200, 1300, 0));
+    e.process(&mut stride(200, 420, 1400, 0));
+    // A gap stride of 420 samples (2.0 cycles) is two strides' length, one of 360 (1.71)
+    // one, one of 370 (1.76) two; never more than four.
+    for (duration, cycles) in [(420, 2), (360, 1), (370, 2), (210, 1), (5000, 4), (1, 1)] {
+        assert_eq!(e.cycles_in(duration), cycles, "{duration}");
+        let mut g = stride(1000, 1000 + duration, 0, StrideFlags::GAP);
+        e.process(&mut g);
+        assert_eq!(g.length_mm, 1350 * cycles, "{duration}");
+    }
+    // With nothing kept, one; from or into a rest (standing in it), or beyond the buffer,
+    // one.
+    assert_eq!(LengthEstimator::new().cycles_in(1000), 1);
+    for f in [
+        StrideFlags::FROM_REST,
+        StrideFlags::TO_REST,
+        StrideFlags::TOO_LONG,
+    ] {
+        let mut g = stride(1000, 1420, 0, StrideFlags::GAP | f);
+        e.process(&mut g);
+        assert_eq!(g.length_mm, 1350, "{f}");
+    }
+}
+
 /// On every recording of every dataset, every stride has a length in the distance: none is
 /// left without one (the first stride of a recording is never a hole here), and the
 /// summary's distance is the sum of them all.
