@@ -7,7 +7,8 @@
 # point vs f64, fixtures, MCAP/CSV readers and the MCAP conformance files, bus faults, gaps,
 # jitter and saturation, property tests, the fuzz corpus and regressions, real datasets when
 # ../shared/datasets is present, the bit-exact QEMU runs of the M4 and M0 firmware, and the instruction counts of
-# the cost benchmark). The cost figures themselves come from tests-host/cost.sh.
+# the cost benchmark), the Bluetooth foot pod against Bumble, and the Python wheel (python/)
+# with its pytest suite beside gaitmap. The cost figures themselves come from tests-host/cost.sh.
 # Installs what a fresh Debian machine lacks: qemu-system-arm, libclang and clang (apt) and
 # flip-link (cargo).
 # rustup installs the toolchain, targets and components named in rust-toolchain.toml; where
@@ -60,6 +61,32 @@ venv="$root/tests-host/target/ble-venv"
 # The binary the cargo tests above built.
 GAITCLIP="$root/tests-host/target/$(rustc -vV | sed -n 's/^host: //p')/debug/gaitclip" \
   "$venv/bin/python" -m pytest -q -p no:cacheprovider "$root/tests-host/ble" 2>&1 | tee -a "$log"
+
+echo "== Python: the gaitclip wheel (PyO3, maturin) and its tests (pytest, gaitmap beside it)"
+# maturin, pytest, pandas and gaitmap, pinned, in a venv of the project's own.
+pyvenv="$root/tests-host/target/py-venv"
+[ -x "$pyvenv/bin/python" ] || python3 -m venv "$pyvenv"
+"$pyvenv/bin/pip" install --quiet --disable-pip-version-check -r "$root/python/requirements-test.txt"
+# gaitmap's example-data loader downloads from GitHub; its sdist on PyPI carries the same
+# files, which go where the loader looks first (GAITMAP_DATA_DIR/v<version>).
+gmdata="$root/tests-host/target/gaitmap-data"
+gmversion=$("$pyvenv/bin/python" -c 'import importlib.metadata as m; print(m.version("gaitmap"))')
+if [ ! -f "$gmdata/v$gmversion/imu_sample.csv" ]; then
+  "$pyvenv/bin/pip" download --quiet --disable-pip-version-check --no-binary :all: --no-deps \
+    "gaitmap==$gmversion" -d "$gmdata/sdist"
+  mkdir -p "$gmdata/v$gmversion"
+  tar -xzf "$gmdata/sdist/gaitmap-$gmversion.tar.gz" -C "$gmdata/sdist"
+  cp "$gmdata/sdist/gaitmap-$gmversion/example_data/"*.csv "$gmdata/v$gmversion/"
+fi
+# The wheel, built by maturin from this workspace in the dev profile (the crates the tests
+# above compiled; `pip install ./python` builds the release one) and installed over any
+# earlier one.
+PATH="$pyvenv/bin:$PATH" MATURIN_PEP517_ARGS="--profile dev" \
+  "$pyvenv/bin/pip" install --quiet --disable-pip-version-check --no-build-isolation \
+  --no-deps --force-reinstall "$root/python"
+GAITCLIP="$root/tests-host/target/$(rustc -vV | sed -n 's/^host: //p')/debug/gaitclip" \
+  GAITMAP_DATA_DIR="$gmdata" \
+  "$pyvenv/bin/python" -m pytest -q -p no:cacheprovider "$root/python/tests" 2>&1 | tee -a "$log"
 
 # One closing line over every test binary and the pytest run.
 awk '/^test result:/ { for (i = 1; i <= NF; i++) { if ($(i) ~ /^passed/) p += $(i-1); if ($(i) ~ /^failed/) f += $(i-1) } }

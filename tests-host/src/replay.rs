@@ -512,6 +512,19 @@ pub fn replay_summarised(
     model: Model,
     all_models: bool,
 ) -> Result<(Vec<StrideReport>, Summary), ReplayError> {
+    let (strides, summary, _) = replay_clocked(trace, ranges, detector, model, all_models)?;
+    Ok((strides, summary))
+}
+
+/// [`replay_summarised`], with the sensor clock the replay recovered (its sample numbers are
+/// the strides' `raw.events`; [`SampleClock::row_of_number`] maps them to the trace's rows).
+pub fn replay_clocked(
+    trace: &Trace,
+    ranges: Ranges,
+    detector: Detector,
+    model: Model,
+    all_models: bool,
+) -> Result<(Vec<StrideReport>, Summary, SampleClock), ReplayError> {
     let prepared = prepare(trace, ranges)?;
     let rate = prepared.rate;
     let mut config = prepared.config(ranges);
@@ -544,7 +557,7 @@ pub fn replay_summarised(
             );
         }
     }
-    Ok((out, summary))
+    Ok((out, summary, prepared.clock))
 }
 
 /// The host's report of a core stride `s` made with `config`, times by `t_s` (sample number to
