@@ -3,7 +3,7 @@
 //! At the end of a stance the foot is at rest, so its velocity is zero (the zero-velocity
 //! update) and its specific force is gravity alone: that levels the attitude (roll and
 //! pitch; yaw is free because a horizontal distance does not depend on it), gives the gyro
-//! bias, and gives the gravity magnitude that calibrates the accelerometer's scale. Over the
+//! bias, and gives the rest's reading of gravity (below: what it means). Over the
 //! movement the attitude follows the gyro, the specific force is rotated into the level
 //! frame, gravity is removed and the rest is integrated twice. At the next stance the
 //! velocity should be zero again; what is left is drift, assumed to have grown linearly over
