@@ -525,6 +525,7 @@ impl<D: StepDetector> Pipeline<D> {
             filter_delay,
             lines,
         });
+        self.estimate.restarted_at(self.next);
         self.next = self.next.wrapping_add(missing);
         self.since_reset = 0;
         self.filter = MeanFilter::with_len_log2(self.filter.window().trailing_zeros());

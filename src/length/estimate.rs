@@ -24,11 +24,17 @@
 //! strides with a quarter cycle's slack (`⌊d/d̄ + ¼⌋`: two cycles from 1.75 of them, so that a
 //! slow single stride stays one; [`MAX_CYCLES`] at most). A stride from or into a rest holds
 //! standing, and counts one; so does a movement longer than its buffer (standing or fiddling
-//! inside it, not cycles: a hole cut into the demo walk's stand made one of 4.9 s). Any other
-//! lasts whole cycles: a stand long enough to break the count restarts detection (a hole
-//! longer than [`crate::pipeline::config::FILL_MAX_MS`]) or is seen as a rest. Found on `ipol_gait_events` (`17-2_right`: 2.5 s of a dense hole cluster
-//! around the U-turn, two steps, estimated as one; now as two, +1.65 m, the only stride of the
-//! four datasets whose estimate changed).
+//! inside it, not cycles: a hole cut into the demo walk's stand made one of 4.9 s); and so does
+//! a stride across a hole that restarted detection (longer than
+//! [`crate::pipeline::config::FILL_MAX_MS`], [`LengthEstimator::restarted_at`]): a stand can
+//! hide in it (a 1.9 s hole cut over the demo walk's stop made one stride of 3.8 s, two
+//! strides and a stand, which counted four). Any other lasts whole cycles: the holes in it
+//! are filled ones, at most 150 ms each, shorter than any stance the foot can rest in, so a
+//! stand between them would be seen as a rest. Found on `ipol_gait_events` (`17-2_right`:
+//! 2.5 s of a dense hole cluster around the U-turn, two steps, estimated as one; now as two,
+//! +1.65 m, the only stride of the four datasets whose estimate changed). Such a stride's
+//! length is then up to [`MAX_CYCLES`] × [`MAX_STRIDE_MM`]: it is the distance of the cycles,
+//! not one stride's.
 //!
 //! With no measured stride yet (a hole before the first) there is nothing to estimate from:
 //! the stride keeps its flags, no length, and the host counts it as unestimated.
@@ -36,7 +42,7 @@
 //! What each flag's estimate costs against the stride's measured length is measured by
 //! cutting holes into real recordings (`gaitclip flags`, `docs/`).
 //!
-//! Integer and bounded: [`HISTORY`] pairs of `u32`.
+//! Integer and bounded: [`HISTORY`] pairs of `u32` and a sample number.
 
 use crate::record::stride::{Stride, StrideFlags, MAX_STRIDE_MM};
 
@@ -59,6 +65,9 @@ pub struct LengthEstimator {
     duration: [u32; HISTORY],
     kept: u8,
     next: u8,
+    /// The first sample of the earliest hole that restarted detection and that no stride
+    /// has ended past yet.
+    restart_hole: Option<u32>,
 }
 
 impl Default for LengthEstimator {
@@ -75,6 +84,15 @@ impl LengthEstimator {
             duration: [0; HISTORY],
             kept: 0,
             next: 0,
+            restart_hole: None,
+        }
+    }
+
+    /// A hole starting at sample `first_missing` restarted detection: a stride across it is
+    /// taken for one cycle (a stand can hide in it). Called by the pipeline, in sample order.
+    pub fn restarted_at(&mut self, first_missing: u32) {
+        if self.restart_hole.is_none() {
+            self.restart_hole = Some(first_missing);
         }
     }
 
@@ -88,6 +106,14 @@ impl LengthEstimator {
     /// [`StrideFlags::ESTIMATED`], unless nothing was measured yet. Never panics.
     pub fn process(&mut self, s: &mut Stride) {
         let duration = s.events.end.wrapping_sub(s.events.start);
+        let across_restart = match self.restart_hole {
+            Some(h) if s.events.end > h => {
+                // Passed: strides from here on start after it.
+                self.restart_hole = None;
+                s.events.start <= h
+            }
+            _ => false,
+        };
         if duration == 0 || duration > u32::MAX / 2 {
             return;
         }
@@ -106,11 +132,14 @@ impl LengthEstimator {
         if let Some(mm) = self.estimate_mm() {
             let within = StrideFlags::FROM_REST | StrideFlags::TO_REST | StrideFlags::TOO_LONG;
             let k = match s.flags.0 & within {
-                0 => self.cycles_in(duration),
+                0 if !across_restart => self.cycles_in(duration),
                 _ => 1,
             };
             s.length_mm = (mm.min(MAX_STRIDE_MM) as u64 * k as u64) as u32;
             s.flags.0 |= StrideFlags::ESTIMATED;
+            if k > 1 {
+                s.flags.0 |= StrideFlags::SEVERAL_CYCLES;
+            }
         }
     }
 

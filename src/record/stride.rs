@@ -60,6 +60,11 @@ impl StrideFlags {
     /// estimate from the strides before it at the same cadence ([`crate::length::estimate`]): it
     /// counts in the distance.
     pub const ESTIMATED: u16 = 1 << 11;
+    /// The stride lasted several gait cycles (holes swallowed a stance instant): its
+    /// estimated length is the cycles' ([`crate::length::estimate`], at most
+    /// [`crate::length::estimate::MAX_CYCLES`] × [`MAX_STRIDE_MM`]), its times theirs, and
+    /// it is not one stride to report as one (a watch's stride length, cadence).
+    pub const SEVERAL_CYCLES: u16 = 1 << 12;
     /// Flags that make a measured length untrustworthy: such a stride's length is estimated
     /// instead ([`StrideFlags::ESTIMATED`]).
     pub const INVALID: u16 = Self::SATURATED | Self::TOO_LONG | Self::GAP | Self::IMPLAUSIBLE;

@@ -292,6 +292,9 @@ pub fn flag_names(f: StrideFlags) -> Vec<&'static str> {
     if f.has(StrideFlags::ESTIMATED) {
         v.push("estimated");
     }
+    if f.has(StrideFlags::SEVERAL_CYCLES) {
+        v.push("several_cycles");
+    }
     v
 }
 

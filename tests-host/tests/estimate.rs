@@ -78,6 +78,12 @@ fn an_unmeasured_stride_of_two_cycles_counts_two() {
         let mut g = stride(1000, 1000 + duration, 0, StrideFlags::GAP);
         e.process(&mut g);
         assert_eq!(g.length_mm, 1350 * cycles, "{duration}");
+        // Flagged as the cycles' length, not one stride's.
+        assert_eq!(
+            g.flags.has(StrideFlags::SEVERAL_CYCLES),
+            cycles > 1,
+            "{duration}"
+        );
     }
     // With nothing kept, one; from or into a rest (standing in it), or beyond the buffer,
     // one.
@@ -91,6 +97,19 @@ fn an_unmeasured_stride_of_two_cycles_counts_two() {
         e.process(&mut g);
         assert_eq!(g.length_mm, 1350, "{f}");
     }
+    // Across a hole that restarted detection (a stand may hide in it), one; a stride that
+    // ends before the hole leaves it pending, the next one past it clears it.
+    e.restarted_at(3000);
+    let mut before = stride(2000, 2840, 0, StrideFlags::GAP);
+    e.process(&mut before);
+    assert_eq!(before.length_mm, 1350 * 4);
+    let mut across = stride(2840, 3500, 0, StrideFlags::GAP);
+    e.process(&mut across);
+    assert_eq!(across.length_mm, 1350);
+    assert!(!across.flags.has(StrideFlags::SEVERAL_CYCLES));
+    let mut after = stride(3500, 3920, 0, StrideFlags::GAP);
+    e.process(&mut after);
+    assert_eq!(after.length_mm, 1350 * 2);
 }
 
 /// On every recording of every dataset, every stride has a length in the distance: none is

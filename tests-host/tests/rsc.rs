@@ -8,6 +8,7 @@
 
 use gaitclip::record::gait::{Gait, GaitParameters};
 use gaitclip::record::stride::{Stride, StrideEvents, StrideFlags};
+use gaitclip::sensor::rate::SampleRate;
 use gaitclip_board::rsc::{self, ControlPointRefusal, FootPod, Measurement};
 
 /// What Nordic's decoder reads from a notification: running, speed m/s, cadence, stride
@@ -120,6 +121,18 @@ fn stride_to_notification_field_by_field() {
     assert_eq!(bytes[0], 0x02);
     assert_eq!(nordic_decode(&bytes).unwrap().3, None);
     assert_eq!(pod.total_distance_dm(), 40);
+    // A gap stride of two cycles, estimated: its length adds to the total but is not one
+    // stride's, and its cadence (from the two cycles' time) is not the walker's: the last
+    // stride's is repeated.
+    let flags = StrideFlags::GAP | StrideFlags::ESTIMATED | StrideFlags::SEVERAL_CYCLES;
+    let mut two = stride(2 * 2650, Gait::Unknown, flags);
+    two.events.end *= 2;
+    two.gait = GaitParameters::of(&two, None, SampleRate::from_hz(200).unwrap());
+    let m = pod.stride(&two, 8600);
+    assert_eq!(m.stride_length_cm, None);
+    assert_eq!(m.cadence_per_min, 55);
+    assert_eq!(two.gait.cadence_spm.div_ceil(2), 28);
+    assert_eq!(m.total_distance_dm, Some(40 + 53));
 }
 
 #[test]

@@ -12,8 +12,8 @@
 //! |---|---|---|---|
 //! | 1 | flags: bit 0 stride length present, bit 1 total distance present, bit 2 running | | [`Gait::Running`] sets bit 2 |
 //! | 2 | instantaneous speed | 1/256 m/s | [`gaitclip::record::gait::GaitParameters::gait_velocity_mm_s`] |
-//! | 1 | instantaneous cadence | 1/min: the sensor's foot's contacts, strides per minute | half [`gaitclip::record::gait::GaitParameters::cadence_spm`], rounded (saturated at 255) |
-//! | 2 | instantaneous stride length (if bit 0) | cm | [`Stride::length_mm`], for a stride that counts in the distance (measured, or estimated) |
+//! | 1 | instantaneous cadence | 1/min: the sensor's foot's contacts, strides per minute | half [`gaitclip::record::gait::GaitParameters::cadence_spm`], rounded (saturated at 255); a stride of several cycles repeats the last one's |
+//! | 2 | instantaneous stride length (if bit 0) | cm | [`Stride::length_mm`], for a stride that counts in the distance (measured, or estimated) and is one stride (not [`StrideFlags::SEVERAL_CYCLES`]: its length is the cycles', and counts in the total distance only) |
 //! | 4 | total distance (if bit 1) | dm | [`FootPod::total_distance_dm`] |
 //!
 //! **Cadence and stride, as RSCS 1.0 defines them**: "the cadence represents the number of
@@ -25,7 +25,7 @@
 //! JSON give. Consumers differ in what they make of it: the interoperability table of docs/bluetooth.md.
 
 use gaitclip::record::gait::Gait;
-use gaitclip::record::stride::Stride;
+use gaitclip::record::stride::{Stride, StrideFlags};
 
 /// The service.
 pub const SERVICE_UUID: u16 = 0x1814;
@@ -98,7 +98,9 @@ impl Measurement {
     /// The measurement of `stride`, with the total distance after it.
     pub fn of_stride(stride: &Stride, total_distance_dm: u32) -> Self {
         let g = &stride.gait;
-        let has_length = stride.flags.counts_distance() && stride.length_mm > 0;
+        let has_length = stride.flags.counts_distance()
+            && stride.length_mm > 0
+            && !stride.flags.has(StrideFlags::SEVERAL_CYCLES);
         Measurement {
             // mm/s · 256/1000, rounded: at most 65 535 mm/s → 16 777 < 2¹⁶.
             speed_256ths_m_s: ((g.gait_velocity_mm_s as u32 * 256 + 500) / 1000) as u16,
@@ -197,6 +199,9 @@ pub struct FootPod {
     last_notified_ms: Option<u32>,
     /// A control-point response is waiting for its indication's confirmation.
     procedure_pending: bool,
+    /// The cadence of the last stride of one cycle, 1/min: what a stride of several cycles
+    /// (whose duration is theirs) reports.
+    last_cadence_per_min: u8,
 }
 
 impl Default for FootPod {
@@ -213,6 +218,7 @@ impl FootPod {
             last_stride_ms: None,
             last_notified_ms: None,
             procedure_pending: false,
+            last_cadence_per_min: 0,
         }
     }
 
@@ -229,7 +235,13 @@ impl FootPod {
         }
         self.last_stride_ms = Some(now_ms);
         self.last_notified_ms = Some(now_ms);
-        Measurement::of_stride(stride, self.total_distance_dm())
+        let mut m = Measurement::of_stride(stride, self.total_distance_dm());
+        if stride.flags.has(StrideFlags::SEVERAL_CYCLES) {
+            m.cadence_per_min = self.last_cadence_per_min;
+        } else {
+            self.last_cadence_per_min = m.cadence_per_min;
+        }
+        m
     }
 
     /// Called about every [`STANDING_EVERY_MS`]: the speed-0 measurement when no stride came

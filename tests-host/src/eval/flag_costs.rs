@@ -27,7 +27,7 @@ use crate::io::trace::Ranges;
 use crate::{io::csv_trace, replay};
 
 /// Every flag, in bit order, with what it does to the length.
-pub const FLAGS: [(u16, &str, &str); 12] = [
+pub const FLAGS: [(u16, &str, &str); 13] = [
     (
         StrideFlags::SATURATED,
         "saturated",
@@ -55,6 +55,11 @@ pub const FLAGS: [(u16, &str, &str); 12] = [
         StrideFlags::ESTIMATED,
         "estimated",
         "the length is the estimate",
+    ),
+    (
+        StrideFlags::SEVERAL_CYCLES,
+        "several_cycles",
+        "the estimate of its cycles",
     ),
 ];
 
