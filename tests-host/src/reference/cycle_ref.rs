@@ -34,6 +34,36 @@ pub struct CoreRun {
     config: Config,
 }
 
+impl CoreRun {
+    /// The stride before stride `k` when it ends where `k` starts (its foot-flat bounds the
+    /// low stretch `k`'s start instant was chosen in).
+    fn previous_contiguous(&self, k: usize) -> Result<&Stride, Skipped> {
+        let s = &self.strides[k];
+        k.checked_sub(1)
+            .map(|j| &self.strides[j])
+            .filter(|p| p.events.end == s.events.start)
+            .ok_or(Skipped::NoPrevious)
+    }
+
+    /// Sample `i` as the core read it.
+    fn sample(&self, i: usize) -> Result<RawSample, Skipped> {
+        self.samples
+            .get(i)
+            .copied()
+            .flatten()
+            .ok_or(Skipped::Missing)
+    }
+
+    /// The calibration the core's decision about sample `i` used.
+    fn calibration(&self, i: usize) -> Result<Calibration, Skipped> {
+        self.calibration
+            .get(i)
+            .copied()
+            .flatten()
+            .ok_or(Skipped::Missing)
+    }
+}
+
 /// Runs the core over `counts` with `gaps` declared (as [`crate::replay::core_run`] does)
 /// and keeps what the twin needs.
 pub fn run(counts: &[RawSample], gaps: &[Gap], config: Config) -> CoreRun {
@@ -107,35 +137,17 @@ pub fn zupt_m(run: &CoreRun, k: usize) -> Result<f64, Skipped> {
     if !s.flags.valid() || s.flags.has(StrideFlags::BRIDGED) {
         return Err(Skipped::Flagged);
     }
-    let prev = k
-        .checked_sub(1)
-        .map(|j| &run.strides[j])
-        .filter(|p| p.events.end == s.events.start)
-        .ok_or(Skipped::NoPrevious)?;
+    let prev = run.previous_contiguous(k)?;
     let (i0, i1) = (s.events.start as usize, s.events.end as usize);
     let (low0, low1) = (prev.events.foot_flat as usize, s.events.foot_flat as usize);
     if i0 - low0 >= 1 << 16 || i1 - low1 >= 1 << 16 {
         return Err(Skipped::LongRest);
     }
-    let sample = |i: usize| {
-        run.samples
-            .get(i)
-            .copied()
-            .flatten()
-            .ok_or(Skipped::Missing)
-    };
-    let cal = |i: usize| {
-        run.calibration
-            .get(i)
-            .copied()
-            .flatten()
-            .ok_or(Skipped::Missing)
-    };
-    let (cal0, cal1) = (cal(i0)?, cal(i1)?);
+    let (cal0, cal1) = (run.calibration(i0)?, run.calibration(i1)?);
     let mean = |a: usize, b: usize| -> Result<Vector3<f64>, Skipped> {
         let mut m = Vector3::zeros();
         for i in a..=b {
-            let x = sample(i)?;
+            let x = run.sample(i)?;
             m += Vector3::new(x.accel[0] as f64, x.accel[1] as f64, x.accel[2] as f64);
         }
         Ok(m / (b - a + 1) as f64)
@@ -161,7 +173,7 @@ pub fn zupt_m(run: &CoreRun, k: usize) -> Result<f64, Skipped> {
     };
 
     let mut q = UnitQuaternion::rotation_between(&up0, &Vector3::z()).ok_or(Skipped::Missing)?;
-    let mut v = rolling(&q, omega(&sample(i0)?, cal0.gyro_bias));
+    let mut v = rolling(&q, omega(&run.sample(i0)?, cal0.gyro_bias));
     let mut p = Vector3::zeros();
     let config_rails = run.config.rails;
     let mut rails = [RailRunF64::default(); 3];
@@ -190,7 +202,7 @@ pub fn zupt_m(run: &CoreRun, k: usize) -> Result<f64, Skipped> {
         }
     };
     for (c, i) in (i0 + 1..=i1).enumerate() {
-        let x = sample(i)?;
+        let x = run.sample(i)?;
         q *= UnitQuaternion::from_scaled_axis(omega(&x, cal0.gyro_bias) * dt);
         let f =
             q * (Vector3::new(x.accel[0] as f64, x.accel[1] as f64, x.accel[2] as f64) - offset);
@@ -227,7 +239,7 @@ pub fn zupt_m(run: &CoreRun, k: usize) -> Result<f64, Skipped> {
         }
     }
     let n = (i1 - i0) as f64;
-    let v_end = rolling(&q, omega(&sample(i1)?, cal1.gyro_bias));
+    let v_end = rolling(&q, omega(&run.sample(i1)?, cal1.gyro_bias));
     // Accelerometer: runs still open at the end booked as they stand, then each loss put
     // back as a velocity step where it happened (a step at sample c moves the trapezoidal
     // position by (N − c + ½)·dt).
@@ -426,34 +438,16 @@ pub fn end_residual(run: &CoreRun, k: usize) -> Result<EndResidual, Skipped> {
     {
         return Err(Skipped::Flagged);
     }
-    let prev = k
-        .checked_sub(1)
-        .map(|j| &run.strides[j])
-        .filter(|p| p.events.end == s.events.start)
-        .ok_or(Skipped::NoPrevious)?;
+    let prev = run.previous_contiguous(k)?;
     let (i0, i1) = (s.events.start as usize, s.events.end as usize);
     let low0 = prev.events.foot_flat as usize;
     if i0 - low0 >= 1 << 16 {
         return Err(Skipped::LongRest);
     }
-    let sample = |i: usize| {
-        run.samples
-            .get(i)
-            .copied()
-            .flatten()
-            .ok_or(Skipped::Missing)
-    };
-    let cal = |i: usize| {
-        run.calibration
-            .get(i)
-            .copied()
-            .flatten()
-            .ok_or(Skipped::Missing)
-    };
-    let (cal0, cal1) = (cal(i0)?, cal(i1)?);
+    let (cal0, cal1) = (run.calibration(i0)?, run.calibration(i1)?);
     let mut up0 = Vector3::zeros();
     for i in low0..=i0 {
-        let x = sample(i)?;
+        let x = run.sample(i)?;
         up0 += Vector3::new(x.accel[0] as f64, x.accel[1] as f64, x.accel[2] as f64);
     }
     let config = &run.config;
@@ -472,10 +466,10 @@ pub fn end_residual(run: &CoreRun, k: usize) -> Result<EndResidual, Skipped> {
         [wl.y, -wl.x]
     };
     let mut q = UnitQuaternion::rotation_between(&up0, &Vector3::z()).ok_or(Skipped::Missing)?;
-    let u0 = per_metre(&q, omega(&sample(i0)?, cal0.gyro_bias));
+    let u0 = per_metre(&q, omega(&run.sample(i0)?, cal0.gyro_bias));
     let mut v = Vector3::zeros();
     for i in i0 + 1..=i1 {
-        let x = sample(i)?;
+        let x = run.sample(i)?;
         q *= UnitQuaternion::from_scaled_axis(omega(&x, cal0.gyro_bias) * dt);
         let f =
             q * (Vector3::new(x.accel[0] as f64, x.accel[1] as f64, x.accel[2] as f64) - offset);
@@ -484,6 +478,6 @@ pub fn end_residual(run: &CoreRun, k: usize) -> Result<EndResidual, Skipped> {
     Ok(EndResidual {
         r: [v.x, v.y],
         u0,
-        u1: per_metre(&q, omega(&sample(i1)?, cal1.gyro_bias)),
+        u1: per_metre(&q, omega(&run.sample(i1)?, cal1.gyro_bias)),
     })
 }
