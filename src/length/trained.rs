@@ -49,6 +49,28 @@ pub const HYPER: [[f64; 3]; 4] = [
     [1.0, 0.03, 0.02],
 ];
 
+/// The grid searches behind `HYPER` and the leave-one-dataset-out fits, each keyed by a
+/// hash of what it searched (the strides, the grid, the code): `(key, [C, γ, ε (m)] per slot,
+/// cross-validated RMSE (m) per slot)`. The host takes a result from here instead of
+/// searching again where the key matches (`tests-host/src/train/cross_validation.rs`).
+pub const SEARCHES: [(u64, [[f64; 3]; 4], [f64; 4]); 3] = [
+    (
+        0xe74671d0610f905f,
+        [[1.0, 0.03, 0.02], [10.0, 0.03, 0.02], [1.0, 0.03, 0.02], [1.0, 0.03, 0.02]],
+        [0.040543988887212765, 0.03991545046058807, 0.039608293355620744, 0.03749042945912342],
+    ),
+    (
+        0xbcdece4c32a60f27,
+        [[1.0, 0.03, 0.02], [10.0, 0.03, 0.02], [1.0, 0.03, 0.02], [1.0, 0.03, 0.02]],
+        [0.041331499608357705, 0.03997467113939941, 0.03933217596167695, 0.03760921372995484],
+    ),
+    (
+        0xc1daa06e75304406,
+        [[1.0, 0.3, 0.05], [1.0, 0.1, 0.02], [1.0, 0.03, 0.02], [1.0, 0.03, 0.02]],
+        [0.04540849248269341, 0.033015661227972753, 0.03557484338083142, 0.030524890266829575],
+    ),
+];
+
 #[cfg(feature = "all-models")]
 static FUSION_PUSH_OFF_FEATURES: [u8; 9] = [
     22 /* push_off.mag.kim */, 6 /* push_off.vert.kim */, 16 /* push_off.mag.max */, 0 /* push_off.vert.max */, 21 /* push_off.mag.weinberg */, 13 /* push_off.sag.weinberg */, 19 /* push_off.mag.mean_abs */, 3 /* push_off.vert.mean_abs */,

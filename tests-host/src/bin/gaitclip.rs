@@ -578,7 +578,12 @@ fn run(cli: Cli) -> anyhow::Result<()> {
             let hyper = fit::hyper_from(&gaitclip::length::trained::HYPER);
             let mut by = Vec::new();
             for v in length_eval::Validation::ALL {
-                let pred = length_eval::predictions(&runs, &hyper, v)?;
+                let (pred, _) = length_eval::predictions(
+                    &runs,
+                    &hyper,
+                    v,
+                    gaitclip_host::train::cross_validation::Search::Recorded,
+                )?;
                 by.push((v, length_eval::score(&runs, &pred), pred));
             }
             let scores: Vec<_> = by.iter().map(|(v, s, _)| (*v, s.clone())).collect();

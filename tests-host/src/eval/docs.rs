@@ -105,7 +105,9 @@ pub fn regenerate_text(
 }
 
 /// Every page of `docs` (`*.md`) regenerated from the datasets under `datasets`; `exe` is
-/// the `gaitclip` binary that runs the command-line blocks.
+/// the `gaitclip` binary that runs the command-line blocks. The blocks are independent
+/// measurements: each distinct one is run once, side by side on the machine's cores
+/// ([`run_side_by_side`]), the longest (`eval`) first.
 pub fn regenerate(docs: &Path, datasets: &Path, exe: &Path) -> Result<Vec<Page>> {
     let mut paths: Vec<PathBuf> = std::fs::read_dir(docs)
         .with_context(|| format!("{}", docs.display()))?
@@ -113,21 +115,64 @@ pub fn regenerate(docs: &Path, datasets: &Path, exe: &Path) -> Result<Vec<Page>>
         .filter(|p| p.extension().is_some_and(|e| e == "md"))
         .collect();
     paths.sort();
-    let mut cache: Vec<(String, String)> = Vec::new();
-    let mut pages = Vec::new();
+    let mut texts = Vec::new();
+    let mut names: Vec<String> = Vec::new();
     for path in paths {
         let text = std::fs::read_to_string(&path).with_context(|| format!("{}", path.display()))?;
-        let (text, stale) = regenerate_text(&text, |name| {
-            if let Some((_, out)) = cache.iter().find(|(n, _)| n == name) {
-                return Ok(out.clone());
+        regenerate_text(&text, |name| {
+            if !names.iter().any(|n| n == name) {
+                names.push(name.to_string());
             }
-            let out = block(name, datasets, exe)?;
-            cache.push((name.to_string(), out.clone()));
-            Ok(out)
+            Ok(String::new())
+        })?;
+        texts.push((path, text));
+    }
+    // The slowest first, so that it does not start last.
+    names.sort_by_key(|n| !n.starts_with("eval"));
+    let outputs = run_side_by_side(&names, |name| block(name, datasets, exe));
+    let mut pages = Vec::new();
+    for (path, text) in texts {
+        let (text, stale) = regenerate_text(&text, |name| {
+            let k = names
+                .iter()
+                .position(|n| n == name)
+                .context("a block not run")?;
+            match &outputs[k] {
+                Ok(out) => Ok(out.clone()),
+                Err(e) => bail!("{e:#}"),
+            }
         })?;
         pages.push(Page { path, text, stale });
     }
     Ok(pages)
+}
+
+/// `run` on every item of `items`, on as many threads as the machine has cores, each taking
+/// the next item when it is done; the results in the order of `items`.
+pub fn run_side_by_side<T: Sync, R: Send>(
+    items: &[T],
+    run: impl Fn(&T) -> Result<R> + Sync,
+) -> Vec<Result<R>> {
+    let threads = std::thread::available_parallelism()
+        .map_or(1, |n| n.get())
+        .min(items.len().max(1));
+    let next = std::sync::atomic::AtomicUsize::new(0);
+    let done: std::sync::Mutex<Vec<(usize, Result<R>)>> = std::sync::Mutex::new(Vec::new());
+    std::thread::scope(|s| {
+        for _ in 0..threads {
+            s.spawn(|| loop {
+                let k = next.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
+                let Some(item) = items.get(k) else {
+                    break;
+                };
+                let r = run(item);
+                done.lock().unwrap_or_else(|e| e.into_inner()).push((k, r));
+            });
+        }
+    });
+    let mut done = done.into_inner().unwrap_or_else(|e| e.into_inner());
+    done.sort_by_key(|(k, _)| *k);
+    done.into_iter().map(|(_, r)| r).collect()
 }
 
 /// What the marker `name` prints.

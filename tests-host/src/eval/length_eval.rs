@@ -123,25 +123,34 @@ fn dataset_of(s: &Sample) -> &str {
 
 /// Fixed-point predictions of every model for `runs`, validated as `v`: in-sample and
 /// k-fold with the SVR hyper-parameters `hyper`; leave-one-dataset-out chooses its own on
-/// the dataset it fits ([`cross_validation::choose_hyper`]), so that nothing of the scored dataset
-/// reaches the model.
-pub fn predictions(runs: &[TrialRun], hyper: &HyperSet, v: Validation) -> Result<Predictions> {
+/// the dataset it fits ([`cross_validation::search`], run or recorded as `how` says: the
+/// searches come back with the predictions), so that nothing of the scored dataset reaches
+/// the model.
+pub fn predictions(
+    runs: &[TrialRun],
+    hyper: &HyperSet,
+    v: Validation,
+    how: cross_validation::Search,
+) -> Result<(Predictions, Vec<cross_validation::Searched>)> {
     match v {
-        Validation::KFold => Ok(cross_validate(runs, hyper)?.0),
+        Validation::KFold => Ok((cross_validate(runs, hyper)?.0, Vec::new())),
         Validation::InSample => {
             let samples = training_set::samples(runs);
             let all: Vec<&Sample> = samples.iter().collect();
             let full = fit::fit_all(&all, hyper)?;
-            Ok(runs
-                .iter()
-                .map(|run| full.with_params(|p| predict_run(run, p)))
-                .collect())
+            Ok((
+                runs.iter()
+                    .map(|run| full.with_params(|p| predict_run(run, p)))
+                    .collect(),
+                Vec::new(),
+            ))
         }
         Validation::LeaveOneDatasetOut => {
             let samples = training_set::samples(runs);
             let all: Vec<&Sample> = samples.iter().collect();
             let full = fit::fit_all(&all, hyper)?;
             let mut fits: BTreeMap<&str, Trained> = BTreeMap::new();
+            let mut searches = Vec::new();
             for left_out in TRAINING_DATASETS {
                 let rest: Vec<Sample> = samples
                     .iter()
@@ -151,17 +160,20 @@ pub fn predictions(runs: &[TrialRun], hyper: &HyperSet, v: Validation) -> Result
                 if rest.is_empty() || rest.len() == samples.len() {
                     continue;
                 }
-                let (h, _) = cross_validation::choose_hyper(&rest)?;
+                let found = cross_validation::search(&rest, how)?;
                 let refs: Vec<&Sample> = rest.iter().collect();
-                fits.insert(left_out, fit::fit_all(&refs, &h)?);
+                fits.insert(left_out, fit::fit_all(&refs, &found.hyper)?);
+                searches.push(found);
             }
-            Ok(runs
-                .iter()
-                .map(|run| {
-                    let model = fits.get(run.dataset.as_str()).unwrap_or(&full);
-                    model.with_params(|p| predict_run(run, p))
-                })
-                .collect())
+            Ok((
+                runs.iter()
+                    .map(|run| {
+                        let model = fits.get(run.dataset.as_str()).unwrap_or(&full);
+                        model.with_params(|p| predict_run(run, p))
+                    })
+                    .collect(),
+                searches,
+            ))
         }
     }
 }

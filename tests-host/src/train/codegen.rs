@@ -180,6 +180,27 @@ pub fn rust_source(t: &Training) -> String {
         let _ = writeln!(s, "    [{:?}, {:?}, {:?}],", h.c, h.gamma, h.eps);
     }
     s.push_str("];\n\n");
+    let _ = writeln!(
+        s,
+        "/// The grid searches behind `HYPER` and the leave-one-dataset-out fits, each keyed by a\n/// hash of what it searched (the strides, the grid, the code): `(key, [C, γ, ε (m)] per slot,\n/// cross-validated RMSE (m) per slot)`. The host takes a result from here instead of\n/// searching again where the key matches (`tests-host/src/train/cross_validation.rs`).\npub const SEARCHES: [(u64, [[f64; 3]; 4], [f64; 4]); {}] = [",
+        t.searches.len()
+    );
+    for r in &t.searches {
+        let h: Vec<String> = r
+            .hyper
+            .iter()
+            .map(|h| format!("[{:?}, {:?}, {:?}]", h.c, h.gamma, h.eps))
+            .collect();
+        let cv: Vec<String> = r.cv_rmse.iter().map(|v| format!("{v:?}")).collect();
+        let _ = writeln!(
+            s,
+            "    (\n        {:#018x},\n        [{}],\n        [{}],\n    ),",
+            r.key,
+            h.join(", "),
+            cv.join(", ")
+        );
+    }
+    s.push_str("];\n\n");
     s.push_str(&body);
     s.push_str("\n/// The trained models. Builds without the `all-models` feature carry the default\n/// model's SVRs only ([`ModelParams::ships`]).\npub static PARAMS: ModelParams<'static> = ModelParams {\n    linear: [\n");
     let lq = tr.linear_q();

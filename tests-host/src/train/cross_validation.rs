@@ -1,5 +1,14 @@
 //! Choosing the SVRs' `C`, `γ` and `ε`: grid search with cross-validation grouped by trial
 //! ([`FOLDS`] folds; a walk's strides are never split between training and test).
+//!
+//! **Recorded searches.** A search is 360 SVR fits (18 grid points × 4 slots × 5 folds), a
+//! minute or two of CPU for each set of training strides; `gaitclip train` runs three (every
+//! training stride, and each leave-one-dataset-out set). Its result is a pure function of
+//! the strides searched, the grid, the folds and the code that fits and scores them, which
+//! [`search_key`] hashes; `gaitclip train` records each search it ran with its key
+//! (`gaitclip::length::trained::SEARCHES`). [`Search::Recorded`] takes a recorded result
+//! whose key matches instead of searching again (what `gaitclip eval` and the staleness
+//! test do), and searches where none does (other datasets, changed features, changed code).
 
 use std::collections::BTreeMap;
 
@@ -50,6 +59,111 @@ fn cv_rmse(
         }
     }
     Ok((se / n.max(1) as f64).sqrt())
+}
+
+/// How a search's result is had.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Search {
+    /// Search the grid (`gaitclip train`).
+    Run,
+    /// The result `gaitclip train` recorded for the same [`search_key`], if any; else search.
+    Recorded,
+}
+
+/// One search's result.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Searched {
+    /// What was searched ([`search_key`]).
+    pub key: u64,
+    /// The grid point chosen per SVR slot.
+    pub hyper: HyperSet,
+    /// Its cross-validated RMSE, m.
+    pub cv_rmse: [f64; 4],
+}
+
+/// 64-bit FNV-1a.
+struct Fnv(u64);
+
+impl Fnv {
+    fn bytes(&mut self, b: &[u8]) {
+        for &x in b {
+            self.0 = (self.0 ^ x as u64).wrapping_mul(0x0000_0100_0000_01b3);
+        }
+    }
+}
+
+/// Hashes the code of a Rust source: every line but comments, without white space, so
+/// that formatting and comments do not count as a change of the search.
+fn code(h: &mut Fnv, source: &str) {
+    for line in source.lines() {
+        let line = line.trim();
+        if line.starts_with("//") {
+            continue;
+        }
+        for c in line.chars().filter(|c| !c.is_whitespace()) {
+            h.bytes(c.encode_utf8(&mut [0; 4]).as_bytes());
+        }
+    }
+}
+
+/// The versions of the crates that fit the SVRs, from the host workspace's lock file.
+fn solver_versions() -> String {
+    let lock = include_str!("../../Cargo.lock");
+    lock.split("[[package]]")
+        .filter(|p| {
+            p.lines()
+                .any(|l| l.starts_with("name = \"linfa") || l.starts_with("name = \"ndarray\""))
+        })
+        .flat_map(|p| p.lines().take(3))
+        .collect::<Vec<_>>()
+        .join("\n")
+}
+
+/// What a search over `samples` is a function of, hashed (FNV-1a, 64 bits): every sample's
+/// group, features, reference length and settings in order; the grid and the folds; the
+/// source of this module and of the fit; the versions of the solver's crates.
+pub fn search_key(samples: &[Sample]) -> u64 {
+    let mut h = Fnv(0xcbf2_9ce4_8422_2325);
+    for s in samples {
+        h.bytes(s.group.as_bytes());
+        h.bytes(&[0]);
+        for v in s.x.iter().chain([&s.y]) {
+            h.bytes(&v.to_bits().to_le_bytes());
+        }
+        h.bytes(&s.settings.height_mm.to_le_bytes());
+    }
+    for v in GRID_C.iter().chain(&GRID_GAMMA).chain(&GRID_EPS) {
+        h.bytes(&v.to_bits().to_le_bytes());
+    }
+    h.bytes(&(FOLDS as u64).to_le_bytes());
+    for source in [include_str!("cross_validation.rs"), include_str!("fit.rs")] {
+        code(&mut h, source);
+    }
+    h.bytes(solver_versions().as_bytes());
+    h.0
+}
+
+/// The search over `samples`, run or recorded as `how` says.
+pub fn search(samples: &[Sample], how: Search) -> Result<Searched> {
+    let key = search_key(samples);
+    if how == Search::Recorded {
+        if let Some((_, hyper, cv_rmse)) = gaitclip::length::trained::SEARCHES
+            .iter()
+            .find(|(k, _, _)| *k == key)
+        {
+            return Ok(Searched {
+                key,
+                hyper: crate::train::fit::hyper_from(hyper),
+                cv_rmse: *cv_rmse,
+            });
+        }
+    }
+    let (hyper, cv_rmse) = choose_hyper(samples)?;
+    Ok(Searched {
+        key,
+        hyper,
+        cv_rmse,
+    })
 }
 
 /// The grid point with the lowest cross-validated RMSE, per SVR slot, with that RMSE.

@@ -23,7 +23,7 @@ use anyhow::Result;
 use gaitclip::length::models::Model;
 
 use crate::eval::length_eval;
-use crate::train::cross_validation::{choose_hyper, folds};
+use crate::train::cross_validation::{self, folds, Search, Searched};
 use crate::train::fit::{fit_all, HyperSet, Sample, Trained};
 use crate::train::training_set::{samples, TrialRun};
 
@@ -42,24 +42,42 @@ pub struct Training {
     pub lodo: Vec<length_eval::DatasetScores>,
     /// The model with the best of them ([`length_eval::lodo_best`]): the firmware's default.
     pub default_model: Model,
+    /// The grid searches behind the hyper-parameters (every training stride's first, then
+    /// each leave-one-dataset-out set's), recorded in the generated source
+    /// ([`cross_validation::Search::Recorded`]).
+    pub searches: Vec<Searched>,
 }
 
-/// Trains every model on `runs`.
+/// Trains every model on `runs`, searching every grid (`gaitclip train`).
 pub fn train(runs: &[TrialRun]) -> Result<Training> {
+    train_with(runs, Search::Run)
+}
+
+/// Trains every model on `runs`, the grid searches run or recorded as `how` says: the same
+/// models either way where the recorded searches are of the same strides and code.
+pub fn train_with(runs: &[TrialRun], how: Search) -> Result<Training> {
     let s = samples(runs);
-    let (hyper, cv_rmse) = choose_hyper(&s)?;
+    let full = cross_validation::search(&s, how)?;
     let refs: Vec<&Sample> = s.iter().collect();
-    let trained = fit_all(&refs, &hyper)?;
+    let trained = fit_all(&refs, &full.hyper)?;
     let trials = folds(s.iter().map(|s| s.group.clone())).len();
-    let pred = length_eval::predictions(runs, &hyper, length_eval::Validation::LeaveOneDatasetOut)?;
+    let (pred, lodo_searches) = length_eval::predictions(
+        runs,
+        &full.hyper,
+        length_eval::Validation::LeaveOneDatasetOut,
+        how,
+    )?;
     let lodo = length_eval::score(runs, &pred);
     let default_model = length_eval::lodo_best(&lodo);
+    let mut searches = vec![full];
+    searches.extend(lodo_searches);
     Ok(Training {
         trained,
-        hyper,
-        cv_rmse,
+        hyper: full.hyper,
+        cv_rmse: full.cv_rmse,
         trials,
         lodo,
         default_model,
+        searches,
     })
 }
