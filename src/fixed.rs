@@ -161,13 +161,14 @@ impl QuatQ30 {
     };
 
     /// Advances the attitude by body rates given as half-angle increments
-    /// `h = ω·dt/2` (Q30 radians per axis, |h| ≤ 0.35: the ±2000 °/s rail at 50 Hz):
+    /// `h = ω·dt/2` (Q30 radians per axis, |h| ≤ 0.70: the ±2000 °/s rail at 25 Hz):
     /// `q ← q + q ⊗ (0, h')`, then one Newton
     /// step of normalisation. The normalised first-order step turns by `2·atan|h'|`, not
     /// `2·|h|`; pre-scaling `h' = h·(1 + |h|²/3)` cancels that to O(|h|⁵), so a step of
     /// θ = 2|h| rad errs by about θ⁵/120 (8e−11 rad at θ = 0.025, 5 rad/s at 200 Hz;
     /// 4.3e−5 rad at θ = 0.35, the ±2000 °/s rail at 100 Hz; 1.4e−3 rad at θ = 0.7, the
-    /// rail at 50 Hz). Up to three Newton steps keep the norm within 2⁻²⁶ (1.5e−8) of one.
+    /// rail at 50 Hz; 4.5e−2 rad at θ = 1.4, the rail at 25 Hz). Up to five Newton steps keep
+    /// the norm within 2⁻²⁶ (1.5e−8) of one (three suffice up to the rail at 50 Hz).
     pub const fn integrate_half_angle(self, h: [i32; 3]) -> QuatQ30 {
         let (w, x, y, z) = (self.w as i64, self.x as i64, self.y as i64, self.z as i64);
         let h2 =
@@ -189,9 +190,10 @@ impl QuatQ30 {
             y: (y + shr_round(dy, 30)) as i32,
             z: (z + shr_round(dz, 30)) as i32,
         };
-        // Walking rates need one Newton step; a step at the gyro rail needs three.
+        // Walking rates need one Newton step; a step at the gyro rail needs three at 50 Hz,
+        // five at 25 Hz (|q|² reaches 1.66 before the first).
         let mut steps = 0;
-        while steps < 3 && (q.norm2_q30() - Q30_ONE as i64).abs() > 1 << 4 {
+        while steps < 5 && (q.norm2_q30() - Q30_ONE as i64).abs() > 1 << 4 {
             q = q.renormalize();
             steps += 1;
         }

@@ -18,7 +18,8 @@
 //! - the sensor's lift and the heading change come from the detector's ZUPT trajectory
 //!   ([`Stride::max_sensor_lift_mm`], [`Stride::turning_angle_cdeg`]);
 //! - walking or running from the **duty factor** (stance time over stride time,
-//!   [`RUNNING_STANCE_MAX_PERMILLE`]).
+//!   [`RUNNING_STANCE_MAX_PERMILLE`]), or stairs up or down from the **climb** where the
+//!   stride rose or fell a stair's height at a stair's slope ([`stairs`]).
 //!
 //! **Walking or running.** A gait is a run when it has a flight phase, both feet off the
 //! ground at once. With the two feet's cycles half a cycle apart, that happens exactly when
@@ -38,6 +39,15 @@ use crate::sensor::rate::SampleRate;
 
 /// Stance below this share of the cycle, ‰, is running (a flight phase, duty factor < 0.5).
 pub const RUNNING_STANCE_MAX_PERMILLE: u16 = 500;
+
+/// A stride that climbs at least this much is on stairs, mm (if steep enough,
+/// [`STAIRS_MIN_SLOPE_PERMILLE`]): a stride climbs one riser step-to-step, two step-over-step,
+/// and risers are 150–200 mm (building codes); a walked slope climbs under 150 mm in a stride
+/// of 1.4 m even at 10 %.
+pub const STAIRS_MIN_CLIMB_MM: u32 = 150;
+/// …at a slope of at least this, ‰ (rise over run: stairs are 0.5–0.8, a ramp at most 0.083
+/// and a steep street 0.2), so that a long stride up a hill is not a flight of stairs.
+pub const STAIRS_MIN_SLOPE_PERMILLE: u32 = 300;
 
 /// Flags under which the stride's times do not describe one gait cycle: a stride from or
 /// into a rest spans the standing, a gap hides events.
@@ -116,7 +126,9 @@ impl GaitParameters {
             let t = cycle_ms as u64;
             (stride.length_mm as u64 * 1000 + t / 2) / t
         };
-        let gait = if stride.flags.0 & NOT_A_CYCLE != 0 || stride_ms == 0 {
+        let gait = if let Some(stairs) = stairs(stride) {
+            stairs
+        } else if stride.flags.0 & NOT_A_CYCLE != 0 || stride_ms == 0 {
             Gait::Unknown
         } else if stance_permille < RUNNING_STANCE_MAX_PERMILLE as u64 {
             Gait::Running
@@ -134,6 +146,27 @@ impl GaitParameters {
             gait,
         }
     }
+}
+
+/// Stairs up or down, where the stride climbed a stair's height at a stair's slope
+/// ([`STAIRS_MIN_CLIMB_MM`], [`STAIRS_MIN_SLOPE_PERMILLE`]); `None` on the level, on a slope a
+/// walker walks, and for a stride without a ZUPT trajectory (Lu's steps, a gap).
+pub const fn stairs(stride: &Stride) -> Option<Gait> {
+    if stride.zupt_um == 0 || stride.flags.0 & StrideFlags::GAP != 0 {
+        return None;
+    }
+    let climb = stride.climb_mm.unsigned_abs() as u64;
+    let level_mm = stride.zupt_um as u64 / 1000;
+    if climb < STAIRS_MIN_CLIMB_MM as u64
+        || climb * 1000 < level_mm * STAIRS_MIN_SLOPE_PERMILLE as u64
+    {
+        return None;
+    }
+    Some(if stride.climb_mm > 0 {
+        Gait::StairsUp
+    } else {
+        Gait::StairsDown
+    })
 }
 
 /// `v` as a `u16`, saturated.

@@ -34,12 +34,13 @@ use crate::detect::foot_frame::FootFrameEstimator;
 use crate::detect::phase_stats::StrideStats;
 use crate::detect::rest::{RestDetector, RestThresholds};
 use crate::detect::seam::{DelayLines, Drain, Input, StepDetector, MAX_MOVEMENT_SAMPLES};
+use crate::detect::step_check::{Path, Rate, Rejected, RejectedMovement, StepLedger};
 use crate::gait::GaitTimer;
 use crate::length::estimate::LengthEstimator;
 use crate::length::models::LengthChain;
 use crate::pipeline::config::{Config, FILL_MAX_MS};
 use crate::pipeline::detectors::AnyDetector;
-use crate::record::stride::Stride;
+use crate::record::stride::{Between, Stride, StrideFlags};
 use crate::sensor::sample::{Origin, Rails, RawSample};
 use crate::signal::bridge;
 use crate::signal::mean_filter::MeanFilter;
@@ -92,6 +93,23 @@ impl HoleCounts {
     }
 }
 
+/// The time outside the strides that counted, by what the foot did ([`Between`], summed):
+/// what the wearer did when not walking.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct BetweenTotals {
+    /// At rest, ms.
+    pub still_ms: u64,
+    /// Moving without a step, ms.
+    pub moving_ms: u64,
+}
+
+impl BetweenTotals {
+    fn add(&mut self, b: Between) {
+        self.still_ms = self.still_ms.saturating_add(b.still_ms as u64);
+        self.moving_ms = self.moving_ms.saturating_add(b.moving_ms as u64);
+    }
+}
+
 /// What [`Pipeline::gap`] does with a hole of a given length (on its own: holes declared
 /// one after the other add up).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -128,6 +146,19 @@ pub struct Pipeline<D = AnyDetector<MAX_MOVEMENT_SAMPLES>> {
     estimate: LengthEstimator,
     /// The last stage: gait parameters from the events and the length.
     gait: GaitTimer,
+    /// The rests and rotations of every sample, which a stride must show to count
+    /// ([`crate::detect::step_check`]), and the movements refused.
+    ledger: StepLedger,
+    check_steps: bool,
+    rejected: Rejected,
+    /// The last movement refused, until [`Pipeline::take_rejected`] takes it.
+    last_rejected: Option<RejectedMovement>,
+    /// Strides that counted so far: the next one's [`Stride::index`].
+    counted: u32,
+    /// The last two strides' numbers and the detector's numbers of their movements (whose
+    /// statistics the detector keeps by its own numbering).
+    numbered: [(u32, u32); 2],
+    between: BetweenTotals,
     /// Accelerometer counts per g.
     accel_lsb_per_g: i32,
     /// Longest hole bridged / filled, samples.
@@ -185,6 +216,19 @@ impl<D: StepDetector> Pipeline<D> {
             detector,
             lines: DelayLines::new(),
             gait: GaitTimer::new(config.rate),
+            ledger: StepLedger::new(config.rate, config.gyro),
+            check_steps: config.check_steps,
+            last_rejected: None,
+            counted: 0,
+            numbered: [(u32::MAX, u32::MAX); 2],
+            rejected: Rejected {
+                by_reason: [0; 3],
+                unchecked: 0,
+            },
+            between: BetweenTotals {
+                still_ms: 0,
+                moving_ms: 0,
+            },
             estimate: LengthEstimator::new(),
             chain: LengthChain {
                 model: config.length_model(),
@@ -290,10 +334,7 @@ impl<D: StepDetector> Pipeline<D> {
         } else {
             self.step(s, Origin::Measured, &mut out);
         }
-        if let Some(st) = out.as_mut() {
-            self.complete(st);
-        }
-        out
+        out.and_then(|st| self.accept(st))
     }
 
     /// [`Pipeline::process`] with a hole pending. Not inlined: the interpolation's
@@ -359,7 +400,12 @@ impl<D: StepDetector> Pipeline<D> {
     /// the strides it is handed. `None` for the peak-valley detector's steps, for gap
     /// strides, and once they are gone.
     pub fn stats(&self, stride: &Stride) -> Option<&StrideStats> {
-        self.detector.stats(stride.index)
+        let movement = self
+            .numbered
+            .iter()
+            .find(|(index, _)| *index == stride.index)
+            .map(|(_, m)| *m)?;
+        self.detector.stats(movement)
     }
 
     /// The holes met so far, by what was done with them.
@@ -387,7 +433,9 @@ impl<D: StepDetector> Pipeline<D> {
             self.at_rest = rest;
             if self.since_reset > self.rest_delay {
                 let at = index.wrapping_sub(self.rest_delay);
-                self.frame.process(&self.lines.raw(at), rest);
+                let raw = self.lines.raw(at);
+                self.frame.process(&raw, rest);
+                self.note_motion(at, rest, &raw);
             }
         }
         let Some(frame) = self.frame.frame() else {
@@ -407,6 +455,47 @@ impl<D: StepDetector> Pipeline<D> {
             accel_lsb_per_g: self.accel_lsb_per_g,
         };
         self.detector.process(&input, out);
+    }
+
+    /// Sample `at` (raw, at rest or not) into the step check's ledger, with its rate about the
+    /// steps' pitch axis once that is known.
+    fn note_motion(&mut self, at: u32, rest: bool, raw: &RawSample) {
+        let rate = match self.frame.frame() {
+            Some(f) => {
+                let b = self.frame.gyro_bias();
+                let w = [
+                    raw.gyro[0] as i32 - b[0],
+                    raw.gyro[1] as i32 - b[1],
+                    raw.gyro[2] as i32 - b[2],
+                ];
+                Rate::Level(f.level_rates(&w))
+            }
+            None => Rate::Unknown,
+        };
+        self.ledger.process(at, rest, rate);
+    }
+
+    /// The step check's record of rests and rotations.
+    pub const fn step_ledger(&self) -> &StepLedger {
+        &self.ledger
+    }
+
+    /// Movements the step check refused, by reason.
+    pub const fn rejected(&self) -> Rejected {
+        self.rejected
+    }
+
+    /// The last movement the step check refused since this was last called (a log or a host
+    /// that reports them takes it after each call that fed samples; an older one not taken
+    /// is only counted).
+    pub fn take_rejected(&mut self) -> Option<RejectedMovement> {
+        self.last_rejected.take()
+    }
+
+    /// The time outside the strides that counted, still and moving, so far (the time after
+    /// the last stride is added when [`Pipeline::finish`] has handed out every stride).
+    pub const fn between(&self) -> BetweenTotals {
+        self.between
     }
 
     /// Declares `missing` samples lost (FIFO overflow, a sensor that stopped answering, a
@@ -526,15 +615,17 @@ impl<D: StepDetector> Pipeline<D> {
             lines,
         });
         self.estimate.restarted_at(self.next);
+        // Measured before the hole's time is handed out: the stride is before it.
+        let out = out.and_then(|s| self.accept(s));
+        let b = self.ledger.hole(self.next, missing);
+        self.between.add(b);
         self.next = self.next.wrapping_add(missing);
         self.since_reset = 0;
         self.filter = MeanFilter::with_len_log2(self.filter.window().trailing_zeros());
         self.rest.reset();
         self.at_rest = false;
         self.frame.gap();
-        // Measured last and once: a single stride on this frame while the models run keeps
-        // the gap path's stack no deeper than a sample's.
-        out.map(|s| self.measured(s))
+        out
     }
 
     /// At the end of a recording: the strides still held or in flight, one per call, until
@@ -555,22 +646,73 @@ impl<D: StepDetector> Pipeline<D> {
                     self.holes.restarted_samples.saturating_add(hole.missing);
             }
         }
-        let (next, filter_delay, lines) = (self.next, self.filter.delay(), &self.lines);
-        let out = self.detector.finish(&Drain {
-            next,
-            filter_delay,
-            lines,
-        });
-        if out.is_none() {
-            self.since_reset = 0;
+        loop {
+            let (next, filter_delay, lines) = (self.next, self.filter.delay(), &self.lines);
+            let out = self.detector.finish(&Drain {
+                next,
+                filter_delay,
+                lines,
+            });
+            match out {
+                None => {
+                    self.since_reset = 0;
+                    let b = self.ledger.tail();
+                    self.between.add(b);
+                    return None;
+                }
+                Some(s) => {
+                    if let Some(s) = self.accept(s) {
+                        return Some(s);
+                    }
+                }
+            }
         }
-        out.map(|s| self.measured(s))
     }
 
-    /// The detector's length chain on a stride that is handed back.
-    fn measured(&mut self, mut s: Stride) -> Stride {
+    /// The step check ([`crate::detect::step_check`]) on a stride the detector handed out,
+    /// then the stages after it; `None` (counted by reason) for a movement that is not a step
+    /// on the ground. A gap stride is not checked: the hole took part of what it would be
+    /// judged on, and it is flagged already.
+    #[inline(never)]
+    fn accept(&mut self, mut s: Stride) -> Option<Stride> {
+        let evidence = self.ledger.evidence(&s);
+        s.swing_deg = evidence.swing_deg.min(u16::MAX as u32) as u16;
+        // A detector that reports seconds late (Lu's) is beyond the ledger's reach: its
+        // strides count unjudged, all of them, so that its counts do not depend on how
+        // late each one came.
+        let unjudgeable = self.detector.reports_late();
+        if self.check_steps && !s.flags.has(StrideFlags::GAP) && unjudgeable {
+            self.rejected.unchecked = self.rejected.unchecked.saturating_add(1);
+        } else if self.check_steps && !s.flags.has(StrideFlags::GAP) {
+            let verdict = evidence.judge(Path::of(&s));
+            self.ledger.judged(&s, &evidence, verdict.is_ok());
+            if let Err(why) = verdict {
+                let n = &mut self.rejected.by_reason[why as usize];
+                *n = n.saturating_add(1);
+                self.last_rejected = Some(RejectedMovement {
+                    start: s.events.start,
+                    end: s.events.end,
+                    movement: (s.events.heel_off, s.events.foot_flat),
+                    reason: why,
+                    swing_deg: s.swing_deg,
+                    swing_peak_mradps: evidence.swing_peak_mradps,
+                    rest: (evidence.rest_before, evidence.rest_after),
+                    horizontal_mm: s.zupt_um / 1000,
+                    climb_mm: s.climb_mm,
+                    lift_mm: s.max_sensor_lift_mm,
+                });
+                return None;
+            }
+        }
+        s.between = self.ledger.between(s.events.start, s.events.end);
+        self.between.add(s.between);
         self.complete(&mut s);
-        s
+        // Numbered among the strides that count (the detector numbers every movement).
+        let movement = s.index;
+        s.index = self.counted;
+        self.numbered[(self.counted & 1) as usize] = (self.counted, movement);
+        self.counted = self.counted.wrapping_add(1);
+        Some(s)
     }
 
     /// The stages after the detector: the length (measured, or estimated where it could

@@ -26,7 +26,7 @@ const CYCLES_PER_US: u32 = 16;
 /// overflows into flip-link's guard at the first stride). Walking movements last
 /// 0.5–1 s and the demo trace's longest is shorter than this, so the strides are those of
 /// the M4 build with its 1 024.
-const MOVEMENT_SAMPLES: usize = 256;
+const MOVEMENT_SAMPLES: usize = 224;
 
 /// The pipeline, built at compile time into .data: no copy of it ever sits on the stack
 /// (moving 8–12 KiB through the stack is more than a 16 KiB part can spare), and the stack

@@ -148,8 +148,12 @@ def replay(
     ``turning_angle`` (deg) (``pre_ic`` is NaN where the stride before does not end at
     ``start``, so it is a float column, as in gaitmap's stride lists), then gaitclip's own columns (``heel_off``, ``foot_flat``, the
     events' times ``*_s``, ``zupt_length``, ``climb``, ``cadence``, ``stance_pct``,
-    ``swing_pct``, ``gait``, ``valid``, ``flags``, ``model``, ``detector``). The replay's
-    summary (holes, clock, counts, distance) is ``frame.attrs["summary"]``.
+    ``swing_pct``, ``gait`` (``walking``, ``running``, ``stairs_up``, ``stairs_down`` or
+    ``unknown``), ``swing_deg``, ``still_before_s`` and ``moving_before_s`` (what the foot did
+    since the stride before that counted: at rest, or moving without a step), ``valid``,
+    ``flags``, ``model``, ``detector``). The replay's summary (holes, clock, counts,
+    distance, the movements the step check refused by reason, minutes still and moving
+    between strides) is ``frame.attrs["summary"]``.
 
     Raises ``ValueError`` for a missing or non-numeric column, a value that is not finite (its
     column and row named), stamps that go back, a unit that cannot be, an unknown detector or

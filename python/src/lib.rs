@@ -113,12 +113,18 @@ fn run<'py>(
         ("gait_velocity_m_s", |s| s.gait_velocity_m_s),
         ("max_sensor_lift_m", |s| s.max_sensor_lift_m),
         ("turning_angle_deg", |s| s.turning_angle_deg),
+        ("still_before_s", |s| s.still_before_s),
+        ("moving_before_s", |s| s.moving_before_s),
     ] {
         put_f(name, f(get))?;
     }
     put_i(
         "cadence_spm",
         strides.iter().map(|s| s.cadence_spm as i64).collect(),
+    )?;
+    put_i(
+        "swing_deg",
+        strides.iter().map(|s| s.swing_deg as i64).collect(),
     )?;
     cols.set_item("model", strides.iter().map(|s| s.model).collect::<Vec<_>>())?;
     cols.set_item(

@@ -47,7 +47,7 @@
 
 use heapless::Vec;
 
-use crate::detect::foot_frame::FootFrameEstimator;
+use crate::detect::foot_frame::{sagittal_rate, FootFrameEstimator};
 use crate::detect::gyro_events;
 use crate::detect::phase_stats::{StrideStats, CHANNELS};
 use crate::detect::phases::{self, PhaseMethod};
@@ -89,6 +89,17 @@ pub const REST_Q16: u64 = 655;
 pub const ATTITUDE_MAX_DEG: u32 = 45;
 /// Gravity against the foot's standing up at a stance, at most, degrees.
 pub const FLAT_MAX_DEG: u32 = 60;
+/// At a zero-velocity instant the foot on the ground turns at most this fast, mrad/s: a
+/// walking foot at its stillest under 0.3 rad/s, a running one rolling over at 0.5–1.5
+/// (`esangeni_run`, `pyshoe_vicon`'s runs). A slow stride's swing holds a steady 3–4 rad/s
+/// through its middle while its energy dips (`esangeni_course`'s slow walks at 800 Hz): an
+/// instant faster than this is a stance only at the walker's own cadence
+/// ([`CADENCE_MIN_PERMILLE`]).
+pub const STANCE_RATE_MAX_MRADPS: u32 = 1500;
+/// A stride that ends at a fast instant ([`STANCE_RATE_MAX_MRADPS`]) lasts at least this share
+/// of the stride before it, ‰: a runner's strides follow one another at one cadence, a split
+/// slow stride's halves last 0.3–0.5 of it.
+pub const CADENCE_MIN_PERMILLE: u32 = 600;
 /// The sensor's height above the foot's rolling contact, µm. A clip on the side of the shoe
 /// sits ≈ 4–6 cm above it, one on the laces ≈ 8–10 cm; measured: docs/accuracy.md (`gaitclip zupt-sweep`).
 pub const SENSOR_HEIGHT_UM: u32 = 80_000;
@@ -143,6 +154,8 @@ pub struct CycleConfig {
     pub restore_accel: bool,
     /// [`gyro_events::SWING_MIN_MRADPS`] in gyro counts.
     swing_min: i16,
+    /// [`STANCE_RATE_MAX_MRADPS`] in gyro counts, squared.
+    stance_rate_max_sq: i64,
 }
 
 impl CycleConfig {
@@ -191,6 +204,10 @@ impl CycleConfig {
             integrator: ZuptIntegrator::new(rate, accel, gyro),
             rails,
             restore_accel: true,
+            stance_rate_max_sq: {
+                let c = gyro.counts_of_mrad_per_s(STANCE_RATE_MAX_MRADPS) as i64;
+                c * c
+            },
             swing_min: {
                 let c = gyro.counts_of_mrad_per_s(gyro_events::SWING_MIN_MRADPS);
                 if c > i16::MAX as u32 {
@@ -355,6 +372,8 @@ pub struct CycleDetector<const M: usize> {
     /// The foot's pitch axis was known when the last sample was decided on: the sagittal
     /// rate in the buffer is about it.
     axis_known: bool,
+    /// The duration of the last stride closed, samples (0 before one): the walker's cadence.
+    last_cycle: u32,
 }
 
 /// The window sum's threshold for a per-sample energy in Q16.
@@ -417,6 +436,7 @@ impl<const M: usize> CycleDetector<M> {
             held: None,
             dropped: 0,
             axis_known: false,
+            last_cycle: 0,
         }
     }
 
@@ -668,6 +688,15 @@ impl<const M: usize> CycleDetector<M> {
             if !agrees(&c.integrator.attitude(), &mean) {
                 return;
             }
+            // A foot turning fast is mid-swing, unless the stride has lasted a cadence's
+            // share of the one before (a runner's rolling stance).
+            let w2: i64 = omega.iter().map(|&w| w as i64 * w as i64).sum();
+            let lasted = i.wrapping_sub(c.start) as u64;
+            if w2 > self.cfg.stance_rate_max_sq
+                && lasted * 1000 < self.last_cycle as u64 * CADENCE_MIN_PERMILLE as u64
+            {
+                return;
+            }
         }
         // The first stance: at rest, or (a recording that starts on the move, or whose
         // first rest ended before the calibration came) after a swing, like any other.
@@ -840,6 +869,9 @@ impl<const M: usize> CycleDetector<M> {
         );
         let next_broken = c.next_broken;
         if spaced {
+            if let Some(cur) = self.cur.as_ref() {
+                self.last_cycle = index.wrapping_sub(cur.start);
+            }
             if let Some(stride) = self.close() {
                 match out {
                     None => *out = Some(stride),
@@ -1034,18 +1066,6 @@ fn mark(flags: &mut u16, s: &RawSample, rails: &Rails, origin: Origin, moving: b
         (Origin::Filled, true) => *flags |= StrideFlags::GAP,
         _ => *flags |= StrideFlags::BRIDGED,
     }
-}
-
-/// The angular rate `omega` (counts, bias removed) about the unit axis `axis` (Q14),
-/// counts, saturated to ±32 767: `|axis| = 2¹⁴` and `|ω| < 2¹⁶` keep each product under
-/// 2³¹ and the sum in an `i64`; within 1 count of the exact projection.
-fn sagittal_rate(axis: &[i32; 3], omega: &[i32; 3]) -> i16 {
-    let dot: i64 = axis
-        .iter()
-        .zip(omega.iter())
-        .map(|(&l, &w)| l as i64 * w as i64)
-        .sum();
-    ((dot + (1 << 13)) >> 14).clamp(-32_767, 32_767) as i16
 }
 
 /// Gravity `mean` (counts·2⁸) within [`FLAT_MAX_DEG`] of the standing up `up`.

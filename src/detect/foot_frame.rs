@@ -62,6 +62,18 @@ const UP_SMOOTHING: f32 = 0.125;
 /// Weight kept by the medio-lateral axis sum at each new movement.
 const AXIS_MEMORY: f32 = 0.875;
 
+/// The angular rate `omega` (counts, bias removed) about the unit axis `axis` (Q14),
+/// counts, saturated to ±32 767: `|axis| = 2¹⁴` and `|ω| < 2¹⁶` keep each product under
+/// 2³¹ and the sum in an `i64`; within 1 count of the exact projection.
+pub fn sagittal_rate(axis: &[i32; 3], omega: &[i32; 3]) -> i16 {
+    let dot: i64 = axis
+        .iter()
+        .zip(omega.iter())
+        .map(|(&l, &w)| l as i64 * w as i64)
+        .sum();
+    ((dot + (1 << 13)) >> 14).clamp(-32_767, 32_767) as i16
+}
+
 /// Rotation from sensor counts into the foot frame, Q14 with the range scaling folded in.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct FootFrame {
@@ -73,6 +85,10 @@ pub struct FootFrame {
     heading_known: bool,
     /// The steps' rotation axis, unit Q14 in sensor axes, once learnt.
     pitch: Option<[i32; 3]>,
+    /// The horizontal axes a step turns the foot about, unit Q14 in sensor axes: the steps'
+    /// pitch axis laid level (left, or a placeholder level axis before any step taught it),
+    /// and the axis across it (forward: a sideways step rolls the foot about it).
+    level_axes_q14: [[i32; 3]; 2],
 }
 
 impl FootFrame {
@@ -116,6 +132,16 @@ impl FootFrame {
     /// horizontal); `None` before a step has been learnt from.
     pub const fn pitch_axis_q14(&self) -> Option<[i32; 3]> {
         self.pitch
+    }
+
+    /// The angular rate `omega` (counts, bias removed) about the two level axes a step turns
+    /// the foot about: the pitch axis laid level, and the axis across it (forward), counts,
+    /// saturated to ±32 767; within 1 count of the exact projection plus the axes' Q14
+    /// rounding (2⁻¹⁴ relative). Before a step has taught the pitch axis, the first axis is a
+    /// placeholder level axis: the pair still spans the horizontal plane.
+    pub fn level_rates(&self, omega: &[i32; 3]) -> [i32; 2] {
+        self.level_axes_q14
+            .map(|axis| sagittal_rate(&axis, omega) as i32)
     }
 
     /// Gravity measured at rest, in g/2048.
@@ -173,6 +199,11 @@ pub struct FootFrameEstimator {
     sum_w: [i64; 3],
     moment: [i64; 3],
     move_n: u32,
+    /// Samples were lost in the movement (or its current chunk): nothing is learnt from it.
+    gapped: bool,
+    /// The movement has gone on past [`AXIS_MAX_MOVEMENT_MS`]: its chunks teach the pitch
+    /// axis, not the heading.
+    chunked: bool,
 }
 
 impl FootFrameEstimator {
@@ -202,6 +233,8 @@ impl FootFrameEstimator {
             sum_w: [0; 3],
             moment: [0; 3],
             move_n: 0,
+            gapped: false,
+            chunked: false,
         }
     }
 
@@ -298,6 +331,8 @@ impl FootFrameEstimator {
                 self.sum_w = [0; 3];
                 self.moment = [0; 3];
                 self.move_n = 0;
+                self.gapped = false;
+                self.chunked = false;
                 self.accumulate_movement(s);
             }
             (false, false) => self.accumulate_movement(s),
@@ -310,7 +345,7 @@ impl FootFrameEstimator {
     /// to learn from is). A rest in progress goes on: its samples are gravity either side.
     pub fn gap(&mut self) {
         if !self.was_rest {
-            self.move_n = self.axis_max;
+            self.gapped = true;
         }
     }
 
@@ -330,7 +365,18 @@ impl FootFrameEstimator {
 
     fn accumulate_movement(&mut self, s: &RawSample) {
         if self.move_n >= self.axis_max {
-            return;
+            // A movement with no rest in it for this long (running, pedalling) teaches the
+            // steps' rotation axis (not the heading: a chunk of a run has no first step to
+            // tell the sign by), and the next chunk starts.
+            if !self.gapped {
+                self.learn_pitch_axis();
+            }
+            self.cov = [0; 6];
+            self.sum_w = [0; 3];
+            self.moment = [0; 3];
+            self.move_n = 0;
+            self.gapped = false;
+            self.chunked = true;
         }
         let w = [0, 1, 2].map(|i| s.gyro[i] as i64 - self.gyro_bias[i] as i64);
         // |w| < 2¹⁷, products < 2³⁴, sums over ≤ 25 000 samples < 2⁴⁹.
@@ -389,10 +435,9 @@ impl FootFrameEstimator {
         self.rebuild();
     }
 
-    fn end_movement(&mut self) {
-        if self.frame.is_none() || self.move_n < self.axis_min || self.move_n >= self.axis_max {
-            return;
-        }
+    /// The principal rotation axis of the movement's rates so far (sensor axes, unit, any
+    /// sign), if it is mostly horizontal (a step's pitch, not a turn on the spot).
+    fn movement_axis(&self) -> Option<Vector3<f32>> {
         let c = self.cov.map(|v| v as f32);
         let cov = Matrix3::new(c[0], c[3], c[4], c[3], c[1], c[5], c[4], c[5], c[2]);
         let eig = SymmetricEigen::new(cov);
@@ -406,9 +451,37 @@ impl FootFrameEstimator {
         let up = Vector3::from(self.up);
         let horizontal = axis - up * axis.dot(&up);
         // A rotation mostly about the vertical is a turn on the spot, not a step.
-        if horizontal.norm() < 0.7 {
+        (horizontal.norm() >= 0.7).then_some(axis)
+    }
+
+    /// Adds `axis` (any sign) to the smoothed pitch axis.
+    fn add_pitch(&mut self, axis: Vector3<f32>) {
+        let pitch = Vector3::from(self.pitch_sum);
+        let along = if axis.dot(&pitch) < 0.0 { -1.0 } else { 1.0 };
+        self.pitch_sum = (pitch * AXIS_MEMORY + axis * along).into();
+    }
+
+    /// A chunk of a movement without rest ([`AXIS_MAX_MOVEMENT_MS`] of running or pedalling):
+    /// its rotation axis is the steps' pitch axis; the heading is not learnt from it.
+    fn learn_pitch_axis(&mut self) {
+        if self.frame.is_none() {
             return;
         }
+        if let Some(axis) = self.movement_axis() {
+            self.add_pitch(axis);
+            self.rebuild();
+        }
+    }
+
+    fn end_movement(&mut self) {
+        if self.frame.is_none() || self.move_n < self.axis_min || self.gapped || self.chunked {
+            return;
+        }
+        let Some(axis) = self.movement_axis() else {
+            return;
+        };
+        let up = Vector3::from(self.up);
+        let horizontal = axis - up * axis.dot(&up);
         let n = self.move_n as f32;
         let centred =
             [0, 1, 2].map(|i| self.moment[i] as f32 - self.sum_w[i] as f32 * (n - 1.0) * 0.5);
@@ -420,9 +493,7 @@ impl FootFrameEstimator {
         let left = horizontal.normalize() * sign;
         let sum = Vector3::from(self.left_sum) * AXIS_MEMORY + left;
         self.left_sum = sum.into();
-        let pitch = Vector3::from(self.pitch_sum);
-        let along = if axis.dot(&pitch) < 0.0 { -1.0 } else { 1.0 };
-        self.pitch_sum = (pitch * AXIS_MEMORY + axis * along).into();
+        self.add_pitch(axis);
         self.heading_known = true;
         self.rebuild();
     }
@@ -459,6 +530,17 @@ impl FootFrameEstimator {
             gravity,
             heading_known: self.heading_known,
             pitch,
+            level_axes_q14: {
+                // The pitch axis where it is known (a run teaches it before the heading),
+                // else the left axis.
+                let p = Vector3::from(self.pitch_sum);
+                let p = p - up * p.dot(&up);
+                let pitch_level = if p.norm() > 1e-3 { p.normalize() } else { left };
+                let across = pitch_level.cross(&up);
+                let q14 =
+                    |v: Vector3<f32>| [0, 1, 2].map(|i| libm_round(v[i] * (1u32 << 14) as f32));
+                [q14(pitch_level), q14(across)]
+            },
         });
     }
 }

@@ -16,4 +16,5 @@ pub mod rest;
 pub mod seam;
 pub mod stance;
 pub mod stance_strides;
+pub mod step_check;
 pub mod zupt;

@@ -786,6 +786,10 @@ impl StepDetector for PeakValleySteps {
         filter_delay + self.peaks.filter_delay()
     }
 
+    fn reports_late(&self) -> bool {
+        true
+    }
+
     fn process(&mut self, x: &Input<'_>, out: &mut Option<Stride>) {
         if out.is_none() {
             *out = self.held.take();

@@ -236,4 +236,14 @@ pub trait StepDetector {
     /// Strides or steps that could not be reported (none by construction; counted so that
     /// a test would see one).
     fn dropped(&self) -> u32;
+
+    /// Whether the detector reports its strides seconds after they ended, by design (Lu's
+    /// rules look up to 16 s ahead): later than the step check's record of the samples
+    /// reaches back ([`crate::detect::step_check`]), so its strides count unjudged (the
+    /// pipeline counts them, [`crate::detect::step_check::Rejected::unchecked`]). False by
+    /// default: a detector that reports within a stride or two is judged on what the record
+    /// still holds.
+    fn reports_late(&self) -> bool {
+        false
+    }
 }

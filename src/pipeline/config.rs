@@ -72,6 +72,10 @@ pub struct Config {
     /// What the accelerometer's reading of gravity at rest, where it is not 1 g, is taken
     /// to be ([`GravityReading::Offset`]; the others for the bias study's comparison).
     pub gravity_reading: GravityReading,
+    /// Whether a stride must be a step on the ground to count ([`crate::detect::step_check`];
+    /// true). A setting so that what the check refuses can be measured against what it lets
+    /// through.
+    pub check_steps: bool,
 }
 
 impl Config {
@@ -94,6 +98,7 @@ impl Config {
             stance: StanceLimits::DEFAULT,
             sensor_height_um: crate::detect::cycle::SENSOR_HEIGHT_UM,
             gravity_reading: GravityReading::Offset,
+            check_steps: true,
         }
     }
 

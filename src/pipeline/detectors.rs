@@ -123,6 +123,11 @@ macro_rules! detectors {
                     $(AnyDetector::$v(d) => StepDetector::dropped(d),)+
                 }
             }
+            fn reports_late(&self) -> bool {
+                match self {
+                    $(AnyDetector::$v(d) => StepDetector::reports_late(d),)+
+                }
+            }
         }
     };
 }

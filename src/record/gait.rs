@@ -1,7 +1,7 @@
 //! A stride's gait parameters, as the last stage of the pipeline ([`crate::gait`]) fills
 //! them in: what a runner's watch and a clinician's stride list read.
 
-/// Walking or running, by the duty factor.
+/// What the stride was: walking or running by the duty factor, stairs by the climb.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
 pub enum Gait {
     /// Stance over [`RUNNING_STANCE_MAX_PERMILLE`](crate::gait::RUNNING_STANCE_MAX_PERMILLE) of the cycle: a double support.
@@ -11,6 +11,10 @@ pub enum Gait {
     /// The stride is not one gait cycle (from or into a rest, across a gap).
     #[default]
     Unknown,
+    /// The stride climbed a stair's height at a stair's slope ([`crate::gait::stairs`]).
+    StairsUp,
+    /// The stride went down a stair's height at a stair's slope.
+    StairsDown,
 }
 
 impl Gait {
@@ -20,6 +24,8 @@ impl Gait {
             Gait::Walking => "walking",
             Gait::Running => "running",
             Gait::Unknown => "unknown",
+            Gait::StairsUp => "stairs_up",
+            Gait::StairsDown => "stairs_down",
         }
     }
 }

@@ -139,7 +139,8 @@ impl StrideEvents {
 /// One stride. Indices are sample numbers since the pipeline started.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
 pub struct Stride {
-    /// Running stride number, from 0.
+    /// Running stride number, from 0, among the strides that count (the pipeline numbers
+    /// them after the step check; a detector numbers the movements it hands out).
     pub index: u32,
     /// Its gait events.
     pub events: StrideEvents,
@@ -163,6 +164,22 @@ pub struct Stride {
     pub gait: GaitParameters,
     /// Qualifiers.
     pub flags: StrideFlags,
+    /// The largest one-way rotation of the foot about its pitch axis in the movement, degrees
+    /// (the swing; [`crate::detect::step_check`]).
+    pub swing_deg: u16,
+    /// What the foot did since the last stride that counted
+    /// ([`crate::detect::step_check`]).
+    pub between: Between,
+}
+
+/// The time between two strides that count, by what the foot did: at rest, or moving
+/// without a step (cycling, a vehicle, fidgeting, and the movements the step check refused).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct Between {
+    /// At rest, ms.
+    pub still_ms: u32,
+    /// Moving, not walking, ms.
+    pub moving_ms: u32,
 }
 
 /// A stride's times in milliseconds, as every log of it states them (the defmt line, the

@@ -11,7 +11,7 @@
 //! sample rate: with `k = 1/√2`, `p = 1 − k·cos ω`, `q = 1 − k`, `1 − α = (p − √(p² − q²)) / q`
 //! ([`alpha_q16`], evaluated at compile time). The cut-off is therefore 3 Hz at every rate,
 //! not only where a continuous-time design would warp little (the host test measures the gain
-//! at 3 Hz at 50–1000 Hz: 0.7070–0.7071).
+//! at 3 Hz at 25–1000 Hz: 0.7070–0.7071).
 //!
 //! **Scaling.** Input: g/[`crate::sensor::units::FOOT_LSB_PER_G`] (`i16`, ±16 g). Output:
 //! g/[`LOW_PASS_LSB_PER_G`] (`i32`), 16 times finer, so that thresholds of 0.01 g are not
@@ -19,7 +19,7 @@
 //! products in `i64`.
 //!
 //! **Error.** Against the same recursion in `f64` (with the same `α`): at most 1 output unit
-//! (g/32 768, 0.03 mg) for any `i16` input at 50–1000 Hz; asserted by a host test
+//! (g/32 768, 0.03 mg) for any `i16` input at 25–1000 Hz; asserted by a host test
 //! (measured: 0.51).
 //!
 //! **Delay.** A one-pole section delays slow signals by `(1 − α)/α` samples; [`LowPass::delay`]
@@ -37,7 +37,7 @@ const STATE_SHIFT: u32 = 12;
 /// Output bits over the input: 32 768 / 2048 = 2⁴.
 const OUT_SHIFT: u32 = 4;
 
-/// `α` of a section at `rate`, Q16 (rounded; 0.0289 at 1 kHz … 0.2528 at 100 Hz, more at 50 Hz): the
+/// `α` of a section at `rate`, Q16 (rounded; 0.0289 at 1 kHz … 0.2528 at 100 Hz, more down to 25 Hz): the
 /// cascade is −3 dB at [`CUTOFF_MHZ`] (see the module's design note).
 pub const fn alpha_q16(rate: SampleRate) -> i64 {
     let w = 2.0 * core::f64::consts::PI * CUTOFF_MHZ as f64 / rate.millihertz() as f64;
@@ -47,7 +47,7 @@ pub const fn alpha_q16(rate: SampleRate) -> i64 {
     ((1.0 - beta) * 65_536.0 + 0.5) as i64
 }
 
-/// cos of `w` ≤ 0.38 rad (3 Hz at 50 Hz): Taylor to `w⁸`, error below 2·10⁻¹¹.
+/// cos of `w` ≤ 0.76 rad (3 Hz at 25 Hz): Taylor to `w⁸`, error below 2·10⁻⁸ (`w¹⁰/10!`).
 const fn cos_small(w: f64) -> f64 {
     let w2 = w * w;
     1.0 - w2 / 2.0 * (1.0 - w2 / 12.0 * (1.0 - w2 / 30.0 * (1.0 - w2 / 56.0)))

@@ -5,11 +5,12 @@ use gaitclip::sensor::sample::RangeScale;
 use std::collections::BTreeMap;
 
 use gaitclip::detect::phase_stats::StrideStats;
+use gaitclip::detect::step_check::{Rejected, RejectedMovement, Rejection};
 use gaitclip::length::features::Features;
 use gaitclip::length::models::{self, Model};
 use gaitclip::pipeline::config::Config;
 use gaitclip::pipeline::detectors::Detector;
-use gaitclip::pipeline::{HoleCounts, Pipeline};
+use gaitclip::pipeline::{BetweenTotals, HoleCounts, Pipeline};
 use gaitclip::record::stride::{Stride, StrideFlags};
 use gaitclip::sensor::rate::SampleRate;
 use gaitclip::sensor::sample::RawSample;
@@ -23,7 +24,7 @@ use crate::io::trace::{Ranges, Trace};
 #[derive(Debug, thiserror::Error)]
 pub enum ReplayError {
     /// The rate is outside what the core supports.
-    #[error("sample rate {0} Hz is outside 50–1000 Hz")]
+    #[error("sample rate {0} Hz is outside 25–1000 Hz")]
     Rate(f64),
     /// The trace has no samples.
     #[error("no samples")]
@@ -88,6 +89,46 @@ pub struct Summary {
     pub retimed_stamps: usize,
     /// The farthest a stamp lay from the clock, ms.
     pub max_stamp_offset_ms: f64,
+    /// Movements the step check refused (not steps on the ground: they count nowhere), by
+    /// reason.
+    pub rejected: BTreeMap<&'static str, u32>,
+    /// Strides counted without the step check: the detector reported them after the check's
+    /// record of their samples was gone (Lu's detector, up to 16 s late).
+    pub unchecked_strides: u32,
+    /// Time outside the strides that counted: at rest, min…
+    pub still_min: f64,
+    /// …and moving without a step (cycling, a vehicle, fidgeting, the refused movements), min.
+    pub moving_min: f64,
+    /// The refused movements one by one (`replay` prints them; not in the summary's JSON).
+    #[serde(skip)]
+    pub rejected_movements: Vec<RejectedReport>,
+}
+
+/// A movement the step check refused, as the host reports it.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct RejectedReport {
+    /// Start, s in the trace's clock.
+    pub start_s: f64,
+    /// End, s.
+    pub end_s: f64,
+    /// Its movement (the detector's heel-off to foot-flat), s.
+    pub movement_s: (f64, f64),
+    /// Why: `no_rest` or `no_swing`.
+    pub reason: &'static str,
+    /// The foot's largest rotation about its pitch axis in it, degrees.
+    pub swing_deg: u16,
+    /// That rotation's fastest rate, rad/s.
+    pub swing_peak_rad_s: f64,
+    /// Whether the foot rested before it, and after it.
+    pub rest_before: bool,
+    /// See `rest_before`.
+    pub rest_after: bool,
+    /// How far the detector's integration moved the foot, m.
+    pub horizontal_m: f64,
+    /// How far it rose, m.
+    pub climb_m: f64,
+    /// The highest the sensor rose above its start, m.
+    pub lift_m: f64,
 }
 
 impl Summary {
@@ -118,6 +159,12 @@ impl Summary {
             }
         }
         self.retimed_stamps += o.retimed_stamps;
+        for (k, v) in &o.rejected {
+            *self.rejected.entry(k).or_default() += v;
+        }
+        self.unchecked_strides += o.unchecked_strides;
+        self.still_min += o.still_min;
+        self.moving_min += o.moving_min;
     }
 
     /// The summary as one line of text.
@@ -168,6 +215,23 @@ impl Summary {
                 clipped.join(", ")
             }
         );
+        let refused: u32 = self.rejected.values().sum();
+        s += &format!(
+            "; not steps: {refused} refused ({}); between strides {:.1} min still, {:.1} min moving",
+            self.rejected
+                .iter()
+                .map(|(k, v)| format!("{v} {k}"))
+                .collect::<Vec<_>>()
+                .join(", "),
+            self.still_min + 0.0,
+            self.moving_min + 0.0
+        );
+        if self.unchecked_strides > 0 {
+            s += &format!(
+                " ({} strides reported too late to check)",
+                self.unchecked_strides
+            );
+        }
         if self.core_rate_hz > 0.0 && self.core_rate_hz < LOW_RATE_HZ {
             s += &format!(
                 "; warning: {:.1} Hz is below {LOW_RATE_HZ} Hz, where gait events are coarse and lengths untested",
@@ -240,6 +304,13 @@ pub struct StrideReport {
     pub turning_angle_deg: f64,
     /// `walking`, `running` (stance under half the cycle) or `unknown` (not one cycle).
     pub gait: &'static str,
+    /// The foot's largest one-way rotation about its pitch axis in the movement (the swing;
+    /// about any horizontal axis before the pitch axis is learnt), degrees.
+    pub swing_deg: u16,
+    /// Since the last stride that counted: time at rest, s…
+    pub still_before_s: f64,
+    /// …and time moving without a step, s.
+    pub moving_before_s: f64,
     /// False when the length was not measured or is not to be trusted (see `flags`; an
     /// `estimated` one still counts in the distance).
     pub valid: bool,
@@ -334,24 +405,60 @@ pub fn core_run_with_stats(
     gaps: &[Gap],
     config: Config,
 ) -> (Vec<(Stride, StrideStats)>, HoleCounts) {
+    let r = core_run_full(samples, gaps, config);
+    (r.strides, r.holes)
+}
+
+/// Everything a run of the core gives: the strides with their phase statistics, the holes,
+/// the movements the step check refused (each, and counted) and the time outside the
+/// strides.
+#[derive(Clone, Debug, Default)]
+pub struct CoreRun {
+    /// The strides and their statistics.
+    pub strides: Vec<(Stride, StrideStats)>,
+    /// What was done with the holes.
+    pub holes: HoleCounts,
+    /// The refused movements, as the pipeline handed them out.
+    pub rejected: Vec<RejectedMovement>,
+    /// Refused movements, counted by reason.
+    pub rejected_counts: Rejected,
+    /// Time outside the strides, still and moving.
+    pub between: BetweenTotals,
+    /// Strides the detector could not hand out (none by construction).
+    pub dropped: u32,
+}
+
+/// [`core_run_with_stats`] and the rest of what the pipeline tells ([`CoreRun`]).
+pub fn core_run_full(samples: &[RawSample], gaps: &[Gap], config: Config) -> CoreRun {
     let mut p = Pipeline::new(config);
-    let mut strides = Vec::new();
+    let mut r = CoreRun::default();
     let with_stats = |p: &Pipeline, s: Stride| (s, p.stats(&s).copied().unwrap_or_default());
     let mut next_gap = gaps.iter().peekable();
     for (i, s) in samples.iter().enumerate() {
         while let Some(g) = next_gap.next_if(|g| g.before <= i) {
             if let Some(st) = p.gap(g.missing) {
-                strides.push(with_stats(&p, st));
+                r.strides.push(with_stats(&p, st));
             }
+            r.rejected.extend(p.take_rejected());
         }
         if let Some(st) = p.process(s) {
-            strides.push(with_stats(&p, st));
+            r.strides.push(with_stats(&p, st));
+        }
+        r.rejected.extend(p.take_rejected());
+    }
+    loop {
+        let st = p.finish();
+        r.rejected.extend(p.take_rejected());
+        match st {
+            Some(st) => r.strides.push(with_stats(&p, st)),
+            None => break,
         }
     }
-    while let Some(st) = p.finish() {
-        strides.push(with_stats(&p, st));
-    }
-    (strides, p.holes())
+    r.holes = p.holes();
+    r.rejected_counts = p.rejected();
+    r.between = p.between();
+    r.dropped = gaitclip::detect::seam::StepDetector::dropped(p.detector());
+    r
 }
 
 /// A trace made ready for the core: its counts, its recovered sample clock (with the holes
@@ -384,7 +491,8 @@ impl Prepared {
 
     /// [`Prepared::strides_with_stats`] and the summary of what was done to the samples.
     pub fn run(&self, config: Config) -> (Vec<(Stride, StrideStats)>, Summary) {
-        let (strides, h) = core_run_with_stats(&self.counts, &self.clock.holes, config);
+        let run = core_run_full(&self.counts, &self.clock.holes, config);
+        let (strides, h) = (run.strides, run.holes);
         let summary = Summary {
             samples_read: self.read.0,
             repeated_dropped: self.read.1,
@@ -430,6 +538,30 @@ impl Prepared {
             core_rate_hz: self.rate.millihertz() as f64 / 1000.0,
             retimed_stamps: self.clock.retimed,
             max_stamp_offset_ms: self.clock.max_offclock_s * 1e3,
+            rejected: Rejection::ALL
+                .iter()
+                .map(|r| (r.name(), run.rejected_counts.by_reason[*r as usize]))
+                .collect(),
+            unchecked_strides: run.rejected_counts.unchecked,
+            still_min: run.between.still_ms as f64 / 60_000.0,
+            moving_min: run.between.moving_ms as f64 / 60_000.0,
+            rejected_movements: run
+                .rejected
+                .iter()
+                .map(|m| RejectedReport {
+                    start_s: self.clock.t_s(m.start),
+                    end_s: self.clock.t_s(m.end),
+                    movement_s: (self.clock.t_s(m.movement.0), self.clock.t_s(m.movement.1)),
+                    reason: m.reason.name(),
+                    swing_deg: m.swing_deg,
+                    swing_peak_rad_s: m.swing_peak_mradps as f64 / 1000.0,
+                    rest_before: m.rest.0,
+                    rest_after: m.rest.1,
+                    horizontal_m: m.horizontal_mm as f64 / 1000.0,
+                    climb_m: m.climb_mm as f64 / 1000.0,
+                    lift_m: m.lift_mm as f64 / 1000.0,
+                })
+                .collect(),
         };
         (strides, summary)
     }
@@ -590,6 +722,9 @@ pub fn report(s: Stride, config: Config, t_s: &impl Fn(u32) -> f64) -> StrideRep
         max_sensor_lift_m: s.max_sensor_lift_mm as f64 / 1000.0,
         turning_angle_deg: s.turning_angle_cdeg as f64 / 100.0,
         gait: s.gait.gait.name(),
+        swing_deg: s.swing_deg,
+        still_before_s: s.between.still_ms as f64 / 1000.0,
+        moving_before_s: s.between.moving_ms as f64 / 1000.0,
         valid: s.flags.valid(),
         flags: flag_names(s.flags),
         raw: s,

@@ -187,20 +187,35 @@ fn serial_stride_line_parses_back() {
     stride.flags.0 = gaitclip::record::stride::StrideFlags::FROM_REST;
     stride.max_sensor_lift_mm = 131;
     stride.turning_angle_cdeg = -215;
+    stride.swing_deg = 62;
+    stride.between = gaitclip::record::stride::Between {
+        still_ms: 1500,
+        moving_ms: 250,
+    };
     stride.gait = gaitclip::record::gait::GaitParameters::of(&stride, None, rate);
     let mut line = String::new();
     serial_line::stride(&mut line, rate, &stride).unwrap();
     assert!(line.len() <= serial_line::MAX_LINE);
     let body = line.strip_suffix("\r\n").expect("CRLF ending");
-    let (numbers, gait) = body.rsplit_once(',').expect("the gait column");
-    assert_eq!(gait, "unknown", "a stride from rest is not one cycle");
-    let f: Vec<i64> = numbers.split(',').map(|v| v.parse().unwrap()).collect();
+    let cells: Vec<&str> = body.split(',').collect();
     let header: Vec<&str> = serial_line::HEADER.split(',').collect();
-    assert_eq!(f.len() + 1, header.len());
+    assert_eq!(cells.len(), header.len());
+    let gait_at = header.iter().position(|h| *h == "gait").unwrap();
+    assert_eq!(
+        cells[gait_at], "unknown",
+        "a stride from rest is not one cycle"
+    );
+    let f: Vec<i64> = cells
+        .iter()
+        .enumerate()
+        .filter(|(k, _)| *k != gait_at)
+        .map(|(_, v)| v.parse().unwrap())
+        .collect();
     assert_eq!(
         f,
         vec![
-            7, 5000, 1362, 1105, 420, 150, 380, 155, -3, 4, 1, 725, 380, 656, 1233, 109, 131, -215
+            7, 5000, 1362, 1105, 420, 150, 380, 155, -3, 4, 1, 725, 380, 656, 1233, 109, 131, -215,
+            62, 1500, 250
         ]
     );
     // Stance and swing times add up to the stride time.
@@ -223,10 +238,18 @@ fn serial_stride_line_parses_back() {
     serial_line::status(
         &mut status,
         u32::MAX,
-        u32::MAX,
-        u64::MAX,
-        u32::MAX,
+        (u32::MAX, u64::MAX, u32::MAX),
         &[u32::MAX; 6],
+        (
+            &gaitclip::detect::step_check::Rejected {
+                by_reason: [u32::MAX; 3],
+                unchecked: u32::MAX,
+            },
+            &gaitclip::pipeline::BetweenTotals {
+                still_ms: u64::MAX,
+                moving_ms: u64::MAX,
+            },
+        ),
         &c,
     )
     .unwrap();

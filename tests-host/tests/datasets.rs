@@ -103,7 +103,9 @@ fn eval_figures_on_recordings() {
     // (dataset, min F1, max median |toe-off|, |heel-strike| ms, min swing IoU)
     for (name, f1, to, hs, iou) in [
         ("gaitmap_walk", 0.99, 30.0, 70.0, 0.80),
-        ("pyshoe_vicon", 0.99, f64::NAN, f64::NAN, f64::NAN),
+        // 0.998 before the step check: it refuses the foot's drags in the crawling trials
+        // (2018-02-09-*: no swing, no step on the ground) and a few slow shuffles.
+        ("pyshoe_vicon", 0.985, f64::NAN, f64::NAN, f64::NAN),
         ("ipol_gait_events", 0.98, 45.0, 35.0, 0.82),
     ] {
         let d = datasets::load(&root.join(name)).unwrap();
@@ -136,10 +138,10 @@ fn eval_figures_on_recordings() {
     }
 }
 
-/// Every detector hands out every stride it numbers, on every recording with holes: the
-/// indices run 0, 1, 2, … without a gap. (A stride the cycle detector released while a
-/// bridged hole was filled up to its held sample, because another hole followed, was once
-/// dropped: `ipol_gait_events/11-4_left`, stride 17.)
+/// Every detector hands out every stride it numbers, on every recording with holes: none is
+/// dropped, and the pipeline's indices run 0, 1, 2, … without a gap. (A stride the cycle
+/// detector released while a bridged hole was filled up to its held sample, because another
+/// hole followed, was once dropped: `ipol_gait_events/11-4_left`, stride 17.)
 #[test]
 fn no_stride_is_lost_between_holes() {
     let Some(root) = root_or_skip("no_stride_is_lost_between_holes") else {
@@ -167,7 +169,13 @@ fn no_stride_is_lost_between_holes() {
                 Ranges::default().gyro.scale(),
             );
             config.detector = *detector;
-            let got = prepared.strides(config);
+            let run = gaitclip_host::replay::core_run_full(
+                &prepared.counts,
+                &prepared.clock.holes,
+                config,
+            );
+            assert_eq!(run.dropped, 0, "{} {}", f.display(), detector.name());
+            let got: Vec<_> = run.strides.iter().map(|(s, _)| *s).collect();
             for (k, s) in got.iter().enumerate() {
                 assert_eq!(
                     s.index as usize,

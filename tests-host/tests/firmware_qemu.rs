@@ -18,7 +18,7 @@ use gaitclip_host::io::trace::Ranges;
 use gaitclip_host::replay::replay_counts_with;
 
 /// The movement buffer of the micro:bit firmware (`boards/microbit/main.rs`).
-const MICROBIT_MOVEMENT_SAMPLES: usize = 256;
+const MICROBIT_MOVEMENT_SAMPLES: usize = 224;
 
 /// Runs a replay firmware in QEMU (virtual time) to its exit, which must be status 0; its
 /// log and the strides it logged.
@@ -89,7 +89,7 @@ fn qemu_m0_bridges_holes_as_the_host_replay() {
         ranges.accel.scale(),
         ranges.gyro.scale(),
     );
-    // With the micro:bit's movement buffer (256 samples): the stride the restart breaks
+    // With the micro:bit's movement buffer (224 samples): the stride the restart breaks
     // runs into the stand after it, longer than that buffer holds (flagged too long there).
     let host_strides = {
         let mut p = gaitclip::pipeline::Pipeline::<
@@ -148,7 +148,7 @@ fn qemu_m0_bridges_holes_as_the_host_replay() {
 
 #[test]
 fn qemu_m4_strides_equal_host_replay() {
-    strides_equal_host_replay(
+    strides_equal_host_replay::<{ gaitclip::detect::seam::MAX_MOVEMENT_SAMPLES }>(
         "boards/mps2-an386",
         "mps2-an386",
         "thumbv7em-none-eabihf",
@@ -159,7 +159,7 @@ fn qemu_m4_strides_equal_host_replay() {
 
 #[test]
 fn qemu_m0_strides_equal_host_replay() {
-    strides_equal_host_replay(
+    strides_equal_host_replay::<MICROBIT_MOVEMENT_SAMPLES>(
         "boards/microbit",
         "microbit",
         "thumbv6m-none-eabi",
@@ -171,7 +171,7 @@ fn qemu_m0_strides_equal_host_replay() {
 /// The firmware built with the `peak-valley-detector` setting, on the smallest board.
 #[test]
 fn qemu_m0_peak_valley_steps_equal_host_replay() {
-    strides_equal_host_replay(
+    strides_equal_host_replay::<MICROBIT_MOVEMENT_SAMPLES>(
         "boards/microbit",
         "microbit",
         "thumbv6m-none-eabi",
@@ -180,7 +180,10 @@ fn qemu_m0_peak_valley_steps_equal_host_replay() {
     );
 }
 
-fn strides_equal_host_replay(
+/// The firmware's strides against the host's replay with the same movement buffer of `M`
+/// samples (the micro:bit keeps fewer than the host: a stride whose movement overflows it is
+/// split on what it kept, on both).
+fn strides_equal_host_replay<const M: usize>(
     dir: &str,
     bin: &str,
     target: &str,
@@ -201,10 +204,16 @@ fn strides_equal_host_replay(
         ranges.gyro.scale(),
     );
     config.detector = detector;
-    let host: Vec<LoggedStride> = replay_counts_with(&counts, config, |i| i as f64)
+    let mut pipeline =
+        gaitclip::pipeline::Pipeline::<gaitclip::pipeline::detectors::AnyDetector<M>>::sized(
+            config,
+        );
+    let mut host: Vec<LoggedStride> = counts
         .iter()
-        .map(|s| LoggedStride::of(&s.raw))
+        .filter_map(|s| pipeline.process(s))
+        .map(|s| LoggedStride::of(&s))
         .collect();
+    host.extend(std::iter::from_fn(|| pipeline.finish()).map(|s| LoggedStride::of(&s)));
     assert!(host.len() >= 20, "host found {} strides", host.len());
     assert_eq!(on_target, host);
 
@@ -421,7 +430,7 @@ fn qemu_m4_sleeps_when_still_and_wakes_as_the_host_model() {
     }
 }
 
-/// The same on the emulated M0 (micro:bit, movement buffer of 256), whose stack has the least
+/// The same on the emulated M0 (micro:bit, movement buffer of 224), whose stack has the least
 /// to spare: the sleep and wake paths run there too, bit-exact with the host model.
 #[test]
 fn qemu_m0_sleeps_when_still_and_wakes_as_the_host_model() {

@@ -110,7 +110,7 @@ fn hamilton_product_within_2_lsb() {
 }
 
 /// Constant rotation at 5 rad/s about a random axis for one second at 200 Hz (0.025 rad a
-/// step), and at the ±2000 °/s rail at 100 Hz and 50 Hz: the integrated attitude stays
+/// step), and at the ±2000 °/s rail at 100, 50 and 25 Hz: the integrated attitude stays
 /// within the per-step error the doc comment of `integrate_half_angle` states, times the
 /// steps, and unit norm within 1e−8.
 #[test]
@@ -120,11 +120,13 @@ fn quaternion_integration_tracks_exact_rotation() {
         let a: [f64; 3] = [0; 3].map(|_| r.random_range(-1.0..1.0));
         let n = a.iter().map(|v| v * v).sum::<f64>().sqrt();
         let axis = a.map(|v| v / n);
-        // At the rail at 50 Hz a step turns 0.7 rad: θ⁵/120 = 1.4e−3 rad per step.
+        // At the rail at 50 Hz a step turns 0.7 rad: θ⁵/120 = 1.4e−3 rad per step; at 25 Hz
+        // 1.4 rad: 4.5e−2 per step.
         for (rate, hz, steps, bound) in [
             (5.0, 200.0, 200, 2e-6),
             (34.9, 100.0, 10, 5e-4),
             (34.9, 50.0, 5, 8e-3),
+            (34.9, 25.0, 3, 1.5e-1),
         ] {
             let h = axis.map(|v| q(v * rate / hz / 2.0));
             let mut att = QuatQ30::IDENTITY;
@@ -206,7 +208,8 @@ fn sample_rate_conversions() {
     let r = SampleRate::from_millihertz(204_800).unwrap();
     assert_eq!(r.samples_in_ms(50), 10); // 10.24
     assert_eq!(r.ms_of_samples(2048), 10_000);
-    assert!(SampleRate::from_hz(49).is_none() && SampleRate::from_hz(1001).is_none());
+    assert!(SampleRate::from_hz(24).is_none() && SampleRate::from_hz(1001).is_none());
+    assert!(SampleRate::from_hz(25).is_some());
     assert!(SampleRate::from_hz(50).is_some());
     assert!(SampleRate::from_hz(u32::MAX).is_none());
 }

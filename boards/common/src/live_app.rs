@@ -310,6 +310,7 @@ impl Drain {
                         self.samples,
                         &counters(),
                         &pipeline.clipped_samples(),
+                        (&pipeline.rejected(), &pipeline.between()),
                         serial,
                     );
                 }

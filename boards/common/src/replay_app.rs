@@ -240,6 +240,7 @@ fn finish<D: StepDetector>(pipeline: &mut Pipeline<D>, log: &mut StrideLog, samp
         samples,
         &LINK.counters(),
         &pipeline.clipped_samples(),
+        (&pipeline.rejected(), &pipeline.between()),
         serial,
     );
     let (used, size) = crate::stack_paint::used_and_size();

@@ -30,8 +30,10 @@
 
 use core::fmt::{self, Write};
 
+use gaitclip::detect::step_check::Rejected;
 use gaitclip::length::models::Model;
 use gaitclip::pipeline::detectors::Detector;
+use gaitclip::pipeline::BetweenTotals;
 use gaitclip::record::stride::Stride;
 use gaitclip::sensor::rate::SampleRate;
 
@@ -39,10 +41,10 @@ use crate::imu_sampler::Counters;
 
 /// Longest line this module writes, with its `\r\n` (the status line with every counter
 /// at its maximum): the size of a board's line buffer.
-pub const MAX_LINE: usize = 384;
+pub const MAX_LINE: usize = 512;
 
 /// The CSV header line.
-pub const HEADER: &str = "index,t_ms,length_mm,duration_ms,stance_ms,push_off_ms,swing_ms,heel_strike_ms,climb_mm,flags,valid,stance_time_ms,swing_time_ms,stance_permille,gait_velocity_mm_s,cadence_spm,max_sensor_lift_mm,turning_angle_cdeg,gait";
+pub const HEADER: &str = "index,t_ms,length_mm,duration_ms,stance_ms,push_off_ms,swing_ms,heel_strike_ms,climb_mm,flags,valid,stance_time_ms,swing_time_ms,stance_permille,gait_velocity_mm_s,cadence_spm,max_sensor_lift_mm,turning_angle_cdeg,gait,swing_deg,still_before_ms,moving_before_ms";
 
 /// The banner and the CSV header.
 pub fn banner(
@@ -69,7 +71,7 @@ pub fn stride(out: &mut impl Write, rate: SampleRate, s: &Stride) -> fmt::Result
     let t = s.times_ms(rate);
     write!(
         out,
-        "{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{}\r\n",
+        "{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{}\r\n",
         s.index,
         t.start,
         s.length_mm,
@@ -88,7 +90,10 @@ pub fn stride(out: &mut impl Write, rate: SampleRate, s: &Stride) -> fmt::Result
         s.gait.cadence_spm,
         s.max_sensor_lift_mm,
         s.turning_angle_cdeg,
-        s.gait.gait.name()
+        s.gait.gait.name(),
+        s.swing_deg,
+        s.between.still_ms,
+        s.between.moving_ms
     )
 }
 
@@ -98,18 +103,21 @@ pub fn comment(out: &mut impl Write, args: fmt::Arguments<'_>) -> fmt::Result {
 }
 
 /// The periodic (and final) status line.
+/// `totals`: strides, distance (mm), estimated strides; `steps`: the movements the step
+/// check refused by reason and the time outside the strides.
 pub fn status(
     out: &mut impl Write,
     samples: u32,
-    strides: u32,
-    distance_mm: u64,
-    estimated: u32,
+    totals: (u32, u64, u32),
     clipped: &[u32; 6],
+    steps: (&Rejected, &BetweenTotals),
     c: &Counters,
 ) -> fmt::Result {
+    let (strides, distance_mm, estimated) = totals;
+    let (rejected, between) = steps;
     write!(
         out,
-        "# status samples={} strides={} distance_mm={} bus_errors={} restarts={} fifo_overflows={} silences={} overruns={} lost_samples={} sleeps={} slept_periods={} estimated={} clipped={},{},{},{},{},{}\r\n",
+        "# status samples={} strides={} distance_mm={} bus_errors={} restarts={} fifo_overflows={} silences={} overruns={} lost_samples={} sleeps={} slept_periods={} estimated={} clipped={},{},{},{},{},{} rejected={},{},{} still_s={} moving_s={}\r\n",
         samples,
         strides,
         distance_mm,
@@ -127,6 +135,11 @@ pub fn status(
         clipped[2],
         clipped[3],
         clipped[4],
-        clipped[5]
+        clipped[5],
+        rejected.by_reason[0],
+        rejected.by_reason[1],
+        rejected.by_reason[2],
+        between.still_ms / 1000,
+        between.moving_ms / 1000
     )
 }

@@ -3,12 +3,13 @@
 //! without a UART pass [`NoSerial`]).
 //!
 //! defmt format (one line per stride; the host's bit-exact test parses it):
-//! `stride <index> t=<start ms> dur=<ms> len=<mm> climb=<mm> phases=<stance>/<push-off>/<swing>/<heel-strike> ms flags=<bits> idx=<start>,<heel_off>,<toe_off>,<heel_strike>,<end>`
+//! `stride <index> t=<start ms> dur=<ms> len=<mm> climb=<mm> phases=<stance>/<push-off>/<swing>/<heel-strike> ms flags=<bits> idx=<start>,<heel_off>,<toe_off>,<heel_strike>,<end> gait=<…> <gait> swing=<deg> before=<still ms>,<moving ms>`
 
 use core::fmt::Write;
 
+use gaitclip::detect::step_check::Rejected;
 use gaitclip::pipeline::config::Config;
-use gaitclip::pipeline::HoleKind;
+use gaitclip::pipeline::{BetweenTotals, HoleKind};
 use gaitclip::record::stride::Stride;
 use gaitclip::sensor::rate::SampleRate;
 
@@ -75,7 +76,7 @@ impl StrideLog {
             self.estimated += 1;
         }
         defmt::println!(
-            "stride {=u32} t={=u32} dur={=u32} len={=u32} climb={=i32} phases={=u32}/{=u32}/{=u32}/{=u32} ms flags={=u16} idx={=u32},{=u32},{=u32},{=u32},{=u32} gait={=u16},{=u16},{=u16},{=u16},{=u16},{=u16},{=i16} {=str}",
+            "stride {=u32} t={=u32} dur={=u32} len={=u32} climb={=i32} phases={=u32}/{=u32}/{=u32}/{=u32} ms flags={=u16} idx={=u32},{=u32},{=u32},{=u32},{=u32} gait={=u16},{=u16},{=u16},{=u16},{=u16},{=u16},{=i16} {=str} swing={=u16} before={=u32},{=u32}",
             s.index,
             t.start,
             t.duration,
@@ -98,7 +99,10 @@ impl StrideLog {
             s.gait.cadence_spm,
             s.max_sensor_lift_mm,
             s.turning_angle_cdeg,
-            s.gait.gait.name()
+            s.gait.gait.name(),
+            s.swing_deg,
+            s.between.still_ms,
+            s.between.moving_ms
         );
         let _ = serial_line::stride(serial, self.rate, s);
     }
@@ -206,9 +210,19 @@ impl StrideLog {
     ///
     /// `clipped`: samples at a rail per axis (accelerometer x, y, z, gyroscope x, y, z;
     /// [`gaitclip::pipeline::Pipeline::clipped_samples`]).
-    pub fn summary(&self, samples: u32, c: &Counters, clipped: &[u32; 6], serial: &mut impl Write) {
+    /// `steps`: the movements the step check refused and the time outside the strides
+    /// ([`gaitclip::pipeline::Pipeline::rejected`], [`gaitclip::pipeline::Pipeline::between`]).
+    pub fn summary(
+        &self,
+        samples: u32,
+        c: &Counters,
+        clipped: &[u32; 6],
+        steps: (&Rejected, &BetweenTotals),
+        serial: &mut impl Write,
+    ) {
+        let (rejected, between) = steps;
         defmt::println!(
-            "summary strides={=u32} distance_mm={=u64} samples={=u32} overruns={=u32} bus_errors={=u32} restarts={=u32} fifo_overflows={=u32} silences={=u32} lost_samples={=u32} sleeps={=u32} slept_periods={=u32} estimated={=u32} clipped={=u32},{=u32},{=u32},{=u32},{=u32},{=u32}",
+            "summary strides={=u32} distance_mm={=u64} samples={=u32} overruns={=u32} bus_errors={=u32} restarts={=u32} fifo_overflows={=u32} silences={=u32} lost_samples={=u32} sleeps={=u32} slept_periods={=u32} estimated={=u32} clipped={=u32},{=u32},{=u32},{=u32},{=u32},{=u32} rejected={=u32},{=u32},{=u32} still_s={=u64} moving_s={=u64}",
             self.strides,
             self.distance_mm,
             samples,
@@ -226,15 +240,19 @@ impl StrideLog {
             clipped[2],
             clipped[3],
             clipped[4],
-            clipped[5]
+            clipped[5],
+            rejected.by_reason[0],
+            rejected.by_reason[1],
+            rejected.by_reason[2],
+            between.still_ms / 1000,
+            between.moving_ms / 1000
         );
         let _ = serial_line::status(
             serial,
             samples,
-            self.strides,
-            self.distance_mm,
-            self.estimated,
+            (self.strides, self.distance_mm, self.estimated),
             clipped,
+            steps,
             c,
         );
     }

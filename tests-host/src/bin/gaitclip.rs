@@ -232,6 +232,13 @@ enum Cmd {
         #[arg(default_value = "../../shared/datasets")]
         datasets: PathBuf,
     },
+    /// Replay recordings of daily life labelled by activity (`hugadb_daily`) and count the
+    /// strides the core reports by activity: where people walk, and where nobody does.
+    Daily {
+        /// The dataset folder (`../shared/datasets/hugadb_daily`).
+        #[arg(default_value = "../../shared/datasets/hugadb_daily")]
+        dir: PathBuf,
+    },
     /// Regenerate the measured tables of `docs/` (the blocks marked `<!-- generated: gaitclip
     /// NAME -->`) from the datasets; `--check` writes nothing and fails on a stale block.
     Docs {
@@ -453,6 +460,23 @@ fn run(cli: Cli) -> anyhow::Result<()> {
                             all.iter().map(|(k, v)| format!("{k} {v:.3}")).collect();
                         println!("           {}", cols.join("  "));
                     }
+                }
+            }
+            for m in &summary.rejected_movements {
+                if json {
+                    println!(
+                        "{}",
+                        serde_json::to_string(&serde_json::json!({ "rejected": m }))?
+                    );
+                } else {
+                    println!(
+                        "not a step  start {:8.3} s  dur {:5.3} s  {}  swing {}°  moved {:.3} m",
+                        m.start_s,
+                        m.end_s - m.start_s,
+                        m.reason,
+                        m.swing_deg,
+                        m.horizontal_m
+                    );
                 }
             }
             if json {
@@ -695,6 +719,7 @@ fn run(cli: Cli) -> anyhow::Result<()> {
         Cmd::Running { datasets } => {
             print!("{}", gaitclip_host::eval::running::report(&datasets)?);
         }
+        Cmd::Daily { dir } => print!("{}", gaitclip_host::eval::daily::report(&dir)?),
         Cmd::Flags { datasets } => {
             print!("{}", gaitclip_host::eval::flag_costs::report(&datasets)?);
         }

@@ -102,8 +102,11 @@ pub struct LoggedStride {
     /// Gait parameters: stance time, swing time (ms), stance ‰, velocity (mm/s), cadence
     /// (steps/min), lift (mm), heading change (centidegrees), and the gait's name.
     pub gait: [i32; 7],
-    /// `walking`, `running` or `unknown`.
+    /// `walking`, `running`, `stairs_up`, `stairs_down` or `unknown`.
     pub gait_name: String,
+    /// The swing, degrees, and the time before the stride since the last one: still and
+    /// moving, ms.
+    pub swing_and_before: [u32; 3],
 }
 
 impl LoggedStride {
@@ -132,6 +135,7 @@ impl LoggedStride {
                 s.turning_angle_cdeg as i32,
             ],
             gait_name: g.gait.name().to_string(),
+            swing_and_before: [s.swing_deg as u32, s.between.still_ms, s.between.moving_ms],
         }
     }
 }
@@ -142,7 +146,7 @@ pub fn parse_stride_line(line: &str) -> Option<LoggedStride> {
     let mut fields = rest.split_whitespace();
     let index = fields.next()?.parse().ok()?;
     let (mut len, mut climb, mut flags, mut idx) = (None, None, None, None);
-    let (mut gait, mut gait_name) = (None, None);
+    let (mut gait, mut gait_name, mut swing, mut before) = (None, None, None, None);
     let mut after_gait = false;
     for f in fields {
         if after_gait {
@@ -159,6 +163,11 @@ pub fn parse_stride_line(line: &str) -> Option<LoggedStride> {
         } else if let Some(v) = f.strip_prefix("idx=") {
             let v: Vec<u32> = v.split(',').filter_map(|x| x.parse().ok()).collect();
             idx = v.try_into().ok();
+        } else if let Some(v) = f.strip_prefix("swing=") {
+            swing = v.parse::<u32>().ok();
+        } else if let Some(v) = f.strip_prefix("before=") {
+            let v: Vec<u32> = v.split(',').filter_map(|x| x.parse().ok()).collect();
+            before = <[u32; 2]>::try_from(v).ok();
         } else if let Some(v) = f.strip_prefix("gait=") {
             let v: Vec<i32> = v.split(',').filter_map(|x| x.parse().ok()).collect();
             gait = v.try_into().ok();
@@ -173,5 +182,9 @@ pub fn parse_stride_line(line: &str) -> Option<LoggedStride> {
         flags: flags?,
         gait: gait?,
         gait_name: gait_name?,
+        swing_and_before: {
+            let b = before?;
+            [swing?, b[0], b[1]]
+        },
     })
 }

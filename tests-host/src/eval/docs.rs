@@ -45,6 +45,7 @@ pub const COMMANDS: &[&str] = &[
     "zupt-sweep",
     "energy",
     "events",
+    "daily",
 ];
 
 const OPEN: &str = "<!-- generated: gaitclip ";

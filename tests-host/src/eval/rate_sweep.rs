@@ -4,7 +4,7 @@
 //! Each recording is replayed at its own rate and decimated by 2, 4 and 8
 //! ([`crate::io::resample`]: anti-aliased, as a slower sensor would record it): `esangeni_run`
 //! from 800 Hz to 400, 200 and 100 Hz, `gaitmap_walk` and `pyshoe_vicon` from ≈ 200 Hz to
-//! 100 and 50 Hz. Every stride of a decimated replay is matched to the stride of the
+//! 100, 50 and 25 Hz (the slowest rate the core takes). Every stride of a decimated replay is matched to the stride of the
 //! full-rate replay it overlaps most in time (at least half of both), and their lengths and
 //! events compared.
 //!
@@ -122,8 +122,8 @@ pub fn report(root: &std::path::Path) -> Result<String> {
     let mut sets: Vec<(String, Vec<Trace>, Vec<usize>)> = Vec::new();
     for (name, factors) in [
         ("esangeni_run", vec![2, 4, 8]),
-        ("gaitmap_walk", vec![2, 4]),
-        ("pyshoe_vicon", vec![2, 4]),
+        ("gaitmap_walk", vec![2, 4, 8]),
+        ("pyshoe_vicon", vec![2, 4, 8]),
     ] {
         let d = datasets::load(&root.join(name))?;
         let traces = d
