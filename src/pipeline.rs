@@ -617,8 +617,7 @@ impl<D: StepDetector> Pipeline<D> {
         self.estimate.restarted_at(self.next);
         // Measured before the hole's time is handed out: the stride is before it.
         let out = out.and_then(|s| self.accept(s));
-        let b = self.ledger.hole(self.next, missing);
-        self.between.add(b);
+        self.ledger.hole(self.next, missing);
         self.next = self.next.wrapping_add(missing);
         self.since_reset = 0;
         self.filter = MeanFilter::with_len_log2(self.filter.window().trailing_zeros());

@@ -304,6 +304,8 @@ pub struct StepLedger {
     started: bool,
     /// Where the last stride that counted ended, and the between-time not yet handed on.
     last_end: Option<u32>,
+    /// Between-time from before a hole, for the next stride.
+    pending: Between,
     /// Where the last step that counted landed: its end, if it ended on the ground (at rest,
     /// or in a runner's stance). The next stride starts from the ground there.
     landed: Option<u32>,
@@ -351,6 +353,10 @@ impl StepLedger {
             started: false,
             last_end: None,
             landed: None,
+            pending: Between {
+                still_ms: 0,
+                moving_ms: 0,
+            },
             rate,
         }
     }
@@ -535,7 +541,17 @@ impl StepLedger {
     pub fn between(&mut self, start: u32, end: u32) -> Between {
         let from = self.last_end.unwrap_or(0);
         self.last_end = Some(end);
-        self.split(from, start)
+        let b = self.split(from, start);
+        self.take_pending(b)
+    }
+
+    /// `b` and what was held over from before a hole, once.
+    fn take_pending(&mut self, b: Between) -> Between {
+        let p = core::mem::take(&mut self.pending);
+        Between {
+            still_ms: b.still_ms.saturating_add(p.still_ms),
+            moving_ms: b.moving_ms.saturating_add(p.moving_ms),
+        }
     }
 
     /// The between-time from the last stride that counted to the last sample fed (the end
@@ -544,20 +560,25 @@ impl StepLedger {
         let from = self.last_end.unwrap_or(0);
         self.last_end = Some(self.next);
         if !self.started {
-            return Between::default();
+            return self.take_pending(Between::default());
         }
-        self.split(from, self.next)
+        let b = self.split(from, self.next);
+        self.take_pending(b)
     }
 
-    /// A hole of `missing` samples after sample `at`: the time before it is handed out
-    /// (its samples are neither still nor moving), the between-time resumes after it.
-    pub fn hole(&mut self, at: u32, missing: u32) -> Between {
+    /// A hole of `missing` samples after sample `at` (lost, or not sampled while the sensor
+    /// slept): the time before it is held over for the next stride's between-time (the hole's
+    /// own samples are neither still nor moving), which resumes after it.
+    pub fn hole(&mut self, at: u32, missing: u32) {
         let from = self.last_end.unwrap_or(0);
         self.last_end = Some(at.wrapping_add(missing));
-        if !Self::before(from, at) {
-            return Between::default();
+        if Self::before(from, at) {
+            let b = self.split(from, at);
+            self.pending = Between {
+                still_ms: self.pending.still_ms.saturating_add(b.still_ms),
+                moving_ms: self.pending.moving_ms.saturating_add(b.moving_ms),
+            };
         }
-        self.split(from, at)
     }
 
     fn split(&self, from: u32, to: u32) -> Between {
@@ -771,20 +792,15 @@ mod tests {
         );
         // The next stride right after: nothing between them.
         assert_eq!(l.between(500, 600), Between::default());
-        // A hole: the time before it is handed out, the hole itself is neither.
+        // A hole: the time before it is held for the next stride (or the end), the hole
+        // itself is neither.
         feed(&mut l, 600, 700, true, Rate::Unknown);
-        assert_eq!(
-            l.hole(700, 1000),
-            Between {
-                still_ms: 1000,
-                moving_ms: 0
-            }
-        );
+        l.hole(700, 1000);
         feed(&mut l, 1700, 1750, false, Rate::Unknown);
         assert_eq!(
             l.tail(),
             Between {
-                still_ms: 0,
+                still_ms: 1000,
                 moving_ms: 500
             }
         );
