@@ -85,25 +85,9 @@ job_wait() {
   fi
 }
 
-stage "toolchain and tools: $(grep '^channel' rust-toolchain.toml), QEMU, clang, flip-link, sccache"
-rustup toolchain install
-bash "$root/boards/install-qemu"
-# The Bluetooth firmware's bindgen needs libclang and clang.
-bash "$root/boards/install-clang"
-# The compiler cache, when it can be had; nothing depends on it.
-# shellcheck source=sccache-env.sh
-source "$root/tests-host/sccache-env.sh"
-# The boards link through flip-link (stack-overflow protection); cargo installs it.
-command -v flip-link >/dev/null 2>&1 || cargo install --locked flip-link
-# clippy lints the workspaces' own crates as they are built (see the top of this file).
-RUSTC_WORKSPACE_WRAPPER=$(rustup which clippy-driver)
-CLIPPY_ARGS="-D__CLIPPY_HACKERY__warnings__CLIPPY_HACKERY__"
-# Fresh clones gain nothing from incremental compilation, and sccache cannot cache it.
-CARGO_INCREMENTAL=0
-export RUSTC_WORKSPACE_WRAPPER CLIPPY_ARGS CARGO_INCREMENTAL
-
-# The Python tools, pinned, in venvs of the project's own: Bumble for the Bluetooth test;
-# maturin, pytest, pandas and gaitmap for the wheel's. gaitmap's example-data loader
+# The Python tools, pinned, in venvs of the project's own (started first: pip's downloads
+# are the longest wait): Bumble for the Bluetooth test; maturin, pytest, pandas and gaitmap
+# for the wheel's. gaitmap's example-data loader
 # downloads from GitHub; its sdist on PyPI carries the same files, which go where the loader
 # looks first (GAITMAP_DATA_DIR/v<version>).
 venv="$root/tests-host/target/ble-venv"
@@ -126,8 +110,34 @@ python_tools() {
   fi
   echo "Python tools ready: $("$venv/bin/python" --version), bumble, maturin, pytest, gaitmap $v"
 }
+# Debian ships venv's pip apart from python3 (python3-venv); the pip job cannot wait on apt.
+if ! python3 -c 'import ensurepip' >/dev/null 2>&1; then
+  echo "python3-venv is missing; installing it from Debian (apt-get install python3-venv)"
+  sudo_cmd=""
+  [ "$(id -u)" -eq 0 ] || sudo_cmd="sudo"
+  $sudo_cmd apt-get update -qq
+  $sudo_cmd apt-get install -y -qq python3-venv
+fi
 mkdir -p "$root/tests-host/target"
 job_start "python tools (pip)" python_tools
+
+stage "toolchain and tools: $(grep '^channel' rust-toolchain.toml), QEMU, clang, flip-link, sccache"
+rustup toolchain install
+bash "$root/boards/install-qemu"
+# The Bluetooth firmware's bindgen needs libclang and clang.
+bash "$root/boards/install-clang"
+# The compiler cache, when it can be had; nothing depends on it.
+# shellcheck source=sccache-env.sh
+source "$root/tests-host/sccache-env.sh"
+# The boards link through flip-link (stack-overflow protection); cargo installs it.
+command -v flip-link >/dev/null 2>&1 || cargo install --locked flip-link
+# clippy lints the workspaces' own crates as they are built (see the top of this file).
+RUSTC_WORKSPACE_WRAPPER=$(rustup which clippy-driver)
+CLIPPY_ARGS="-D__CLIPPY_HACKERY__warnings__CLIPPY_HACKERY__"
+# Fresh clones gain nothing from incremental compilation, and sccache cannot cache it.
+CARGO_INCREMENTAL=0
+export RUSTC_WORKSPACE_WRAPPER CLIPPY_ARGS CARGO_INCREMENTAL
+
 
 stage "core library and board glue on the host: rustfmt, clippy, unit tests, docs"
 cargo fmt --all --check

@@ -9,26 +9,32 @@
 //! - **A step leaves a rest and comes back to one.** A walking, shuffling or stair-climbing
 //!   foot is still on the ground between its movements (the orientation-free rest test of
 //!   [`crate::detect::rest`]: the specific force steady within 0.6 m/s², the rate under
-//!   0.7 rad/s, over 50 ms). A pedalling foot never is: it circles the crank at 1–1.5 m/s.
-//!   A car's floor and an elevator leave the foot at rest, so rest alone is no step.
-//! - **A step swings the foot about its medio-lateral axis.** The foot rolls onto its toes,
-//!   then turns toe-up through the swing by 60–100° in walking (90–120° running, 30–60° on
-//!   stairs; gaitclip's [`crate::detect::gyro_events`] calls the largest of these rotations
-//!   the swing), where a car's vibration, an elevator or a shift of weight turns it by a few
-//!   degrees. The check measures the largest one-way rotation (lobe of the sagittal rate about
-//!   the steps' pitch axis, [`crate::detect::foot_frame::FootFrame::pitch_axis_q14`]) inside
-//!   the stride's movement, [`SWING_MIN_DEG`]; a stride whose foot slid without turning (a
-//!   shuffle) passes on its displacement instead, [`STEP_MIN_MM`].
-//! - **A running foot has no rest, but a running swing.** At a run the foot is never still by
-//!   the rest test; its swing turns it through ≥ 90° (`esangeni_run`: 87–135° from jog to
-//!   run), more than pedalling's 30–60° (ankling, Hoshikawa et al. 2007) ever does:
-//!   [`RUN_SWING_DEG`] stands for the rest.
+//!   0.7 rad/s, over 50 ms), within [`REST_NEAR_MS`] of the stride's ends; or the step before
+//!   landed where this one starts. A pedalling foot never rests: it circles the crank at
+//!   1–1.5 m/s. A car's floor and an elevator leave the foot at rest, so rest alone is no step.
+//! - **A step swings the foot.** The foot rolls onto its toes, then turns toe-up through the
+//!   swing by 60–100° in walking (90–120° running, 30–60° on stairs), about its
+//!   medio-lateral axis, or rolls about the axis across it in a sideways step; a car's
+//!   vibration, an elevator or a shift of weight turns it by a few degrees. The check takes
+//!   the largest one-way rotation (a lobe of the rate about either level axis,
+//!   [`crate::detect::foot_frame::FootFrame::level_rates`]) inside the stride: at least
+//!   [`SWING_MIN_DEG`], turning at least [`SWING_MIN_MRADPS`] at its fastest (a foot drifting on
+//!   a seat turns slower). A shuffle slides the foot a step's length ([`STEP_MIN_MM`]) on the
+//!   level ([`LEVEL_MAX_MM`]) turning it less ([`SHUFFLE_SWING_MIN_DEG`]); a turn on the spot
+//!   turns it about the vertical ([`TURN_STEP_MIN_DEG`]).
+//! - **A running foot has no rest, but a runner's swing.** At a run the foot is never still
+//!   by the rest test; its swing peaks at 6–20 rad/s, faster than pedalling's ankling ever
+//!   turns it (2–4 rad/s; 2.7 the median of `hugadb_daily`'s rides): [`RUN_SWING_MRADPS`]
+//!   stands for the rest.
+//! - **A step takes the time of a step.** A movement longer than [`STEP_MAX_MS`] is not one.
 //!
 //! **What it keeps.** Per sample, O(1) and integer, fed by the pipeline whatever the
-//! detector: the runs of rest decisions (a ring of the last [`RESTS`]) and the one-way
-//! rotations of the sagittal rate (a ring of the last [`LOBES`] larger than
-//! [`LOBE_KEEP_DEG`]). A detector reports a stride later than its samples (a centred window,
-//! a confirmation): by then both rings hold its span, which the check reads back.
+//! detector: the runs of rest decisions (a ring of the last [`RESTS`], blips under
+//! [`REST_BLIP_MS`] merged) and the one-way rotations about the level axes (a ring of the last
+//! [`LOBES`] larger than [`LOBE_KEEP_DEG`]). A detector reports a stride later than its
+//! samples (a centred window, a confirmation): by then both rings hold its span, which the
+//! check reads back ([`StepLedger::evidence`], judged by [`StepEvidence::judge`]). A detector
+//! that reports seconds late (Lu's) is beyond them: its strides count unchecked.
 //!
 //! **Between the strides.** The same rest runs tell the time between two strides that count
 //! apart: still (at rest) or moving without walking (cycling, a vehicle, fidgeting, the
