@@ -217,9 +217,16 @@ fn daily_life_counts_strides_only_where_people_step() {
 }
 
 /// The walk-jog-run-sprint courses: no stride split in two. A slow stride's steady mid-swing
-/// rate once ended a stride there (0.38 m + 0.66 m halves of 1.25 m, each half 0.3–0.5 of its
-/// neighbours' duration); no stride now lasts under 0.4 of the median of the six around it,
-/// and at most one per course under 0.6 (a stop between two paces).
+/// rate once ended a stride there (0.38 m + 0.66 m halves of 1.25 m, the foot turning at
+/// 3–4 rad/s at the cut). Judged on the raw gyro, not on the detector's own test:
+///
+/// - every stride begins and ends where the foot is on the ground: within ±20 ms of the
+///   boundary the foot turns slower than 1.5 rad/s at some sample (a walking foot at its
+///   stillest under 0.3 rad/s, a runner's rolling contact 0.5–1.5);
+/// - a stride shorter than 0.6 of the median of the six around it is a step at a stand or a
+///   turn between the course's segments, not half a stride: one of its ends is a stand (the
+///   foot under 0.5 rad/s), and a course has at most two (its stands and turns: slow to fast
+///   walk, forward to backward, backward to sideways, left to right).
 #[test]
 fn no_course_stride_is_split_in_two() {
     let Some(root) = root_or_skip("no_course_stride_is_split_in_two") else {
@@ -236,24 +243,50 @@ fn no_course_stride_is_split_in_two() {
     for f in &files {
         let trace = csv_trace::read(f, None).unwrap();
         let strides = replay(&trace, Ranges::default()).unwrap();
+        assert!(
+            strides.len() > 40,
+            "{}: {} strides",
+            f.display(),
+            strides.len()
+        );
+        // The slowest the foot turns within ±20 ms of `t`, rad/s.
+        let slowest = |t: f64| -> f64 {
+            let i = ((t - trace.samples[0].t_s) * trace.rate_hz).round() as usize;
+            let w = (0.02 * trace.rate_hz).round() as usize;
+            trace.samples[i.saturating_sub(w)..(i + w + 1).min(trace.samples.len())]
+                .iter()
+                .map(|s| s.gyr_radps.iter().map(|g| g * g).sum::<f64>().sqrt())
+                .fold(f64::INFINITY, f64::min)
+        };
         let d: Vec<f64> = strides.iter().map(|s| s.end_s - s.start_s).collect();
         let mut short = 0;
-        for k in 0..d.len() {
+        for (k, s) in strides.iter().enumerate() {
+            for t in [s.start_s, s.end_s] {
+                assert!(
+                    slowest(t) < 1.5,
+                    "{}: stride {k} has an end at {t:.3} s where the foot turns at {:.2} rad/s",
+                    f.display(),
+                    slowest(t)
+                );
+            }
             let mut around: Vec<f64> = (k.saturating_sub(3)..(k + 4).min(d.len()))
                 .filter(|&j| j != k)
                 .map(|j| d[j])
                 .collect();
             around.sort_by(f64::total_cmp);
             let median = around[around.len() / 2];
-            assert!(
-                d[k] >= 0.4 * median,
-                "{}: stride {k} at {:.2} s lasts {:.2} s, its neighbours {median:.2} s",
-                f.display(),
-                strides[k].start_s,
-                d[k]
-            );
-            short += usize::from(d[k] < 0.6 * median);
+            if d[k] < 0.6 * median {
+                short += 1;
+                assert!(
+                    slowest(s.start_s).min(slowest(s.end_s)) < 0.5,
+                    "{}: stride {k} at {:.2} s lasts {:.2} s, its neighbours {median:.2} s, \
+                     and neither end is a stand",
+                    f.display(),
+                    s.start_s,
+                    d[k]
+                );
+            }
         }
-        assert!(short <= 1, "{}: {short} strides under 0.6", f.display());
+        assert!(short <= 2, "{}: {short} strides under 0.6", f.display());
     }
 }
