@@ -37,7 +37,14 @@ host=$(rustc -vV 2>/dev/null | sed -n 's/^host: //p' || true)
 jobs_dir=$(mktemp -d)
 log="$jobs_dir/tests.log"
 : > "$log"
-trap 'kill $(jobs -p) 2>/dev/null || true; rm -rf "$jobs_dir"' EXIT
+# On the way out (a failed stage, ^C) the jobs beside stop too, with what they started (pip,
+# cargo, pytest), so that nothing keeps writing into a clone after the script has ended.
+kill_tree() {
+  local c
+  for c in $(cat /proc/"$1"/task/*/children 2>/dev/null); do kill_tree "$c"; done
+  kill "$1" 2>/dev/null || true
+}
+trap 'for p in $(jobs -p); do kill_tree "$p"; done; rm -rf "$jobs_dir"' EXIT
 
 # Stage times: `stage NAME` ends the stage before it and starts NAME; a background job
 # (`job_start`) times itself. Printed in the closing lines.
