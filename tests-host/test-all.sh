@@ -162,14 +162,18 @@ RUSTDOCFLAGS="-D warnings" cargo doc --no-deps
 firmware() {
   set -e
   local dir
-  for dir in "$root"/boards/*/; do
+  # The emulated boards and the benchmark first: the host tests run them in QEMU and wait for
+  # cargo's lock on the build folder while this job holds it.
+  for dir in "$root"/boards/{mps2-an386,microbit,bench}/ "$root"/boards/*/; do
+    case " ${built:-} " in *" $dir "*) continue ;; esac
+    built="${built:-} $dir"
     [ -f "$dir/.cargo/config.toml" ] || continue
     local t0=$SECONDS
     (cd "$dir" && cargo build --release --quiet)
     echo "${dir#"$root"/}: built and linted in $((SECONDS - t0)) s"
   done
 }
-stage "firmware (beside) and the host tools' build"
+stage "the host tools' build (the firmware beside it)"
 job_start "firmware: every board and the benchmark" firmware
 cd "$root/tests-host"
 # The host tests with cargo-nextest where the machine has it (every test binary's tests on
@@ -183,9 +187,8 @@ if [ "$runner" = nextest ]; then
 else
   cargo test --workspace --no-run
 fi
-job_wait "firmware: every board and the benchmark"
 
-stage "tests-host: the host tests (and the Bluetooth test beside them)"
+stage "tests-host: the host tests (and the firmware and Bluetooth beside them)"
 job_wait "python tools (pip)"
 # The Bluetooth foot pod (gaitclip pod) against Bumble's virtual controller and a Bumble
 # central: replays in real time, so it runs beside the host tests.
@@ -198,6 +201,9 @@ if [ "$runner" = nextest ]; then
 else
   cargo test --workspace 2>&1 | tee -a "$log"
 fi
+# The boards' fat-LTO links run on one core each: they go on beside the host tests, which
+# take the other, and are waited for here.
+job_wait "firmware: every board and the benchmark"
 
 stage "Python: the gaitclip wheel (PyO3, maturin) and its tests (pytest, gaitmap beside it)"
 # The wheel, built by maturin from this workspace in the dev profile (the crates the tests
