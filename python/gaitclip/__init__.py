@@ -12,9 +12,15 @@ Units of the input, told apart by the columns, never guessed from the values:
   m/s², ``gyr_*`` in rad/s;
 - a DataFrame without one is gaitmap's: ``acc_*`` in m/s², ``gyr_*`` in deg/s, one row per
   sample at ``sampling_rate_hz``;
-- ``gyr_unit="deg/s"`` or ``"rad/s"`` says it outright. A gyro that cannot be in the unit it
-  was read in (over 35 rad/s, beyond any IMU's range; or under 30 °/s while the accelerometer
-  shows steps) raises ``ValueError`` naming the unit to pass.
+- ``gyr_unit="deg/s"`` or ``"rad/s"`` and ``acc_unit="g"``, ``"mg"`` or ``"m/s^2"`` say it
+  outright, for a DataFrame or a path (a path's ``meta.json`` may say it too: ``"units":
+  {"acc": "g", "gyr": "deg/s"}``). Values that cannot be in their unit (an accelerometer
+  whose stillest quarter does not read about 1 g; a gyro over 75 rad/s, beyond any IMU's range, or under
+  30 °/s while the accelerometer shows steps) raise ``ValueError`` naming the unit they look
+  like; the check is the command line's own (Rust, ``gaitclip_host::io::units``).
+
+A recording below ``LOW_RATE_HZ`` (the core's checked range) replays with a
+``GaitclipWarning``, as the command line warns.
 
 Axes are the sensor's, any mounting: the core finds the foot frame itself.
 """
@@ -23,6 +29,7 @@ from __future__ import annotations
 
 import json
 import os
+import warnings
 from typing import Any, Dict, Mapping, Optional, Tuple, Union
 
 import numpy as np
@@ -30,9 +37,24 @@ import pandas as pd
 
 from . import _gaitclip
 
-__all__ = ["replay", "GaitclipStrides", "DETECTORS", "MODELS", "DEFAULT_MODEL", "__version__"]
+__all__ = [
+    "replay",
+    "GaitclipStrides",
+    "GaitclipWarning",
+    "DETECTORS",
+    "MODELS",
+    "DEFAULT_MODEL",
+    "LOW_RATE_HZ",
+    "__version__",
+]
 
 __version__: str = _gaitclip.__version__
+LOW_RATE_HZ: float = _gaitclip.LOW_RATE_HZ
+
+
+class GaitclipWarning(UserWarning):
+    """A recording gaitclip replays but whose strides it cannot vouch for (a low rate)."""
+
 DETECTORS, MODELS, DEFAULT_MODEL = _gaitclip.names()
 
 ACC = ["acc_x", "acc_y", "acc_z"]
@@ -129,15 +151,18 @@ def replay(
     model: Optional[str] = None,
     all_models: bool = False,
     gyr_unit: Optional[str] = None,
+    acc_unit: Optional[str] = None,
     acc_range_g: Optional[float] = None,
     gyro_range_dps: Optional[float] = None,
+    rate_overrides_stamps: bool = False,
 ) -> pd.DataFrame:
     """Replays one sensor's recording through gaitclip's core and returns its strides.
 
     ``data`` is a DataFrame of one sensor (the module's docs say how its units are read) or
-    the path of a ``.csv`` (the datasets' layout) or ``.mcap`` file. ``sampling_rate_hz`` is
-    the nominal rate (needed without a ``t_s`` column; otherwise the stamps give it, and the
-    core runs on the clock it recovers from them). ``detector`` is ``cycle`` (the firmware's),
+    the path of a CSV (the datasets' layout) or MCAP file (told by its first bytes, whatever
+    its name). ``sampling_rate_hz`` is the nominal rate (needed without a ``t_s`` column;
+    otherwise the stamps give it, and the core runs on the clock it recovers from them; a
+    rate more than 10 % off the stamps' is refused unless ``rate_overrides_stamps=True``). ``detector`` is ``cycle`` (the firmware's),
     ``stance`` (Huang's) or ``lu`` (Lu's peak-valley, measured by ``lu_fuzzy`` only);
     ``model`` names the length model behind ``stride_length`` (default: the firmware's);
     ``all_models`` adds a ``length_<model>`` column for every model.
@@ -156,8 +181,9 @@ def replay(
     between strides) is ``frame.attrs["summary"]``.
 
     Raises ``ValueError`` for a missing or non-numeric column, a value that is not finite (its
-    column and row named), stamps that go back, a unit that cannot be, an unknown detector or
-    model, or a malformed file (its line and column named); ``FileNotFoundError`` for a path
+    column and row named), stamps that go back, a unit that cannot be, a rate the stamps
+    contradict, an unknown detector or model, or a malformed file (its line and column
+    named); ``FileNotFoundError`` for a path
     that is not there.
     """
     if isinstance(data, (str, os.PathLike)):
@@ -165,7 +191,16 @@ def replay(
         if not os.path.exists(path):
             raise FileNotFoundError(path)
         native = _gaitclip.replay_path(
-            path, sampling_rate_hz, detector, model, all_models, acc_range_g, gyro_range_dps
+            path,
+            sampling_rate_hz,
+            detector,
+            model,
+            all_models,
+            acc_range_g,
+            gyro_range_dps,
+            acc_unit,
+            gyr_unit,
+            rate_overrides_stamps,
         )
     elif isinstance(data, pd.DataFrame):
         columns = _columns(data)
@@ -185,6 +220,8 @@ def replay(
                 all_models,
                 acc_range_g,
                 gyro_range_dps,
+                acc_unit,
+                rate_overrides_stamps,
             )
         except ValueError as e:
             if "not a finite number" in str(e):
@@ -192,7 +229,16 @@ def replay(
             raise
     else:
         raise TypeError(f"data must be a DataFrame or a path, not {type(data).__name__}")
-    return _to_frame(native, all_models)
+    frame = _to_frame(native, all_models)
+    rate = frame.attrs["summary"].get("core_rate_hz", 0.0)
+    if 0.0 < rate < LOW_RATE_HZ:
+        warnings.warn(
+            f"the recording is at {rate:.1f} Hz, below {LOW_RATE_HZ:g} Hz: gait events are "
+            "coarse and lengths are not checked at this rate",
+            GaitclipWarning,
+            stacklevel=2,
+        )
+    return frame
 
 
 class GaitclipStrides:
@@ -215,11 +261,13 @@ class GaitclipStrides:
         model: Optional[str] = None,
         all_models: bool = False,
         gyr_unit: Optional[str] = None,
+        acc_unit: Optional[str] = None,
     ) -> None:
         self.detector = detector
         self.model = model
         self.all_models = all_models
         self.gyr_unit = gyr_unit
+        self.acc_unit = acc_unit
 
     def get_params(self) -> Dict[str, Any]:
         """The constructor's parameters, as gaitmap's and scikit-learn's objects give them."""
@@ -228,6 +276,7 @@ class GaitclipStrides:
             "model": self.model,
             "all_models": self.all_models,
             "gyr_unit": self.gyr_unit,
+            "acc_unit": self.acc_unit,
         }
 
     def _one(self, data: pd.DataFrame, sampling_rate_hz: float):
@@ -238,6 +287,7 @@ class GaitclipStrides:
             model=self.model,
             all_models=self.all_models,
             gyr_unit=self.gyr_unit,
+            acc_unit=self.acc_unit,
         )
         complete = strides.dropna(subset=["pre_ic"])
         stride_list = complete[STRIDE_LIST].astype("int64")

@@ -18,8 +18,10 @@ def replay(
     model: Optional[str] = None,
     all_models: bool = False,
     gyr_unit: Optional[str] = None,
+    acc_unit: Optional[str] = None,
     acc_range_g: Optional[float] = None,
     gyro_range_dps: Optional[float] = None,
+    rate_overrides_stamps: bool = False,
 ) -> pd.DataFrame: ...
 
 class GaitclipStrides:
@@ -27,6 +29,7 @@ class GaitclipStrides:
     model: Optional[str]
     all_models: bool
     gyr_unit: Optional[str]
+    acc_unit: Optional[str]
     data: Union[pd.DataFrame, Mapping[str, pd.DataFrame]]
     sampling_rate_hz: float
     strides_: Union[pd.DataFrame, Dict[str, pd.DataFrame]]
@@ -39,6 +42,7 @@ class GaitclipStrides:
         model: Optional[str] = None,
         all_models: bool = False,
         gyr_unit: Optional[str] = None,
+        acc_unit: Optional[str] = None,
     ) -> None: ...
     def get_params(self) -> Dict[str, Any]: ...
     def estimate(

@@ -17,9 +17,11 @@ use std::path::{Path, PathBuf};
 use gaitclip::length::models::Model;
 use gaitclip::pipeline::detectors::Detector;
 use gaitclip_host::io::clock::{self, SampleClock};
-use gaitclip_host::io::csv_trace::{self, CsvError};
-use gaitclip_host::io::mcap_io::{self, McapError};
+use gaitclip_host::io::csv_trace::CsvError;
+use gaitclip_host::io::mcap_io::McapError;
+use gaitclip_host::io::recording::{self, ReadError};
 use gaitclip_host::io::trace::{GivenRanges, ImuSample, Ranges, Trace};
+use gaitclip_host::io::units::{self, Front, Units};
 use gaitclip_host::replay::{self, StrideReport};
 use numpy::{IntoPyArray, PyReadonlyArray1};
 use pyo3::exceptions::{PyFileNotFoundError, PyValueError};
@@ -185,48 +187,18 @@ fn run<'py>(
     Ok((cols, summary))
 }
 
-/// The gyro read as `unit` (`rad/s` or `deg/s`) in rad/s; `Err` where it cannot be in that
-/// unit: a 99.9th percentile of |ω| over 35 rad/s (beyond any IMU's range), or under 30 °/s
-/// while the accelerometer's magnitude spreads by more than 2 m/s² (steps).
-fn gyro_in_radps(samples: &mut [ImuSample], unit: &str) -> PyResult<()> {
-    let k = match unit {
-        "rad/s" => 1.0,
-        "deg/s" => std::f64::consts::PI / 180.0,
-        _ => {
-            return Err(PyValueError::new_err(format!(
-                "gyr_unit must be 'deg/s' or 'rad/s', not '{unit}'"
-            )))
-        }
-    };
-    for s in samples.iter_mut() {
-        s.gyr_radps = s.gyr_radps.map(|v| v * k);
-    }
-    let norm = |v: [f64; 3]| (v[0] * v[0] + v[1] * v[1] + v[2] * v[2]).sqrt();
-    let mut rate: Vec<f64> = samples.iter().map(|s| norm(s.gyr_radps)).collect();
-    let at = ((rate.len() as f64 * 0.999) as usize).min(rate.len() - 1);
-    let top = *rate.select_nth_unstable_by(at, f64::total_cmp).1;
-    if top > 35.0 {
-        return Err(PyValueError::new_err(format!(
-            "the gyro reaches {top:.0} rad/s read as {unit}, beyond any IMU's range: is it in deg/s? pass gyr_unit='deg/s'"
-        )));
-    }
-    let acc: Vec<f64> = samples.iter().map(|s| norm(s.acc_mps2)).collect();
-    let mean = acc.iter().sum::<f64>() / acc.len() as f64;
-    let spread =
-        (acc.iter().map(|a| (a - mean) * (a - mean)).sum::<f64>() / acc.len() as f64).sqrt();
-    if spread > 2.0 && top < 30f64.to_radians() {
-        return Err(PyValueError::new_err(format!(
-            "the accelerometer shows steps but the gyro stays under 30 °/s read as {unit}: is it in rad/s? pass gyr_unit='rad/s'"
-        )));
-    }
-    Ok(())
+/// The units named by Python's `acc_unit` and `gyr_unit` (`None`: m/s², rad/s).
+fn units_named(acc: Option<&str>, gyr: Option<&str>) -> PyResult<Units> {
+    Units::from_names(acc, gyr).map_err(|e| PyValueError::new_err(e.to_string()))
 }
 
 /// Replays one sensor given as arrays: `t_s` (s; `None`: the rows at `rate_hz`), `acc`
-/// (x, y, z: m/s², gravity included) and `gyr` (x, y, z: in `gyr_unit`, `rad/s` or `deg/s`),
-/// in the sensor's axes (any mounting). Returns the strides' columns and the summary's JSON.
+/// (x, y, z: in `acc_unit`, `m/s^2`, `g` or `mg`, gravity included) and `gyr` (x, y, z: in
+/// `gyr_unit`, `rad/s` or `deg/s`), in the sensor's axes (any mounting), the units checked as
+/// the CLI checks a file's (`gaitclip_host::io::units`). Returns the strides' columns and the
+/// summary's JSON.
 #[pyfunction]
-#[pyo3(signature = (t_s, acc, gyr, gyr_unit, rate_hz, detector, model, all_models, acc_range_g=None, gyro_range_dps=None))]
+#[pyo3(signature = (t_s, acc, gyr, gyr_unit, rate_hz, detector, model, all_models, acc_range_g=None, gyro_range_dps=None, acc_unit=None, rate_overrides_stamps=false))]
 #[allow(clippy::too_many_arguments)]
 fn replay_arrays<'py>(
     py: Python<'py>,
@@ -240,9 +212,12 @@ fn replay_arrays<'py>(
     all_models: bool,
     acc_range_g: Option<f64>,
     gyro_range_dps: Option<f64>,
+    acc_unit: Option<&str>,
+    rate_overrides_stamps: bool,
 ) -> PyResult<(Bound<'py, PyDict>, String)> {
     let o = options(detector, model, all_models)?;
     ranges_given(acc_range_g, gyro_range_dps)?;
+    let declared = units_named(acc_unit, Some(gyr_unit))?;
     let (a, g) = (
         acc.each_ref().map(|v| v.as_array()),
         gyr.each_ref().map(|v| v.as_array()),
@@ -294,7 +269,16 @@ fn replay_arrays<'py>(
             gyr_radps: gyr,
         });
     }
-    gyro_in_radps(&mut samples, gyr_unit)?;
+    units::apply(&mut samples, declared, Front::Python)
+        .map_err(|e| PyValueError::new_err(e.to_string()))?;
+    if let (Some(given), true, false) = (rate_hz, t_s.is_some(), rate_overrides_stamps) {
+        if let Err(stamps) = recording::rate_agrees(&samples, given) {
+            return Err(PyValueError::new_err(format!(
+                "sampling_rate_hz={given} is {:+.0} % off the t_s stamps' {stamps:.4} Hz: leave it out to replay on the stamps' clock, or pass rate_overrides_stamps=True if the stamps are the ones that are wrong",
+                (given / stamps - 1.0) * 100.0
+            )));
+        }
+    }
     // Re-sent samples are dropped as the file readers drop them; `keep` maps the rows left
     // back to the input's.
     let period = match rate_hz {
@@ -328,12 +312,13 @@ fn replay_arrays<'py>(
     run(py, trace, o, |row| keep[(row as usize).min(last)] as u64)
 }
 
-/// Replays a recording file: `.csv` (the datasets' layout: `t_s, acc_*` in m/s², `gyr_*` in
-/// rad/s; a `meta.json` beside it gives the rate and ranges) or `.mcap`, as `gaitclip
-/// replay` reads it. Returns the strides' columns (rows of the samples kept, a re-sent one
-/// dropped) and the summary's JSON.
+/// Replays a recording file: CSV (the datasets' layout: `t_s, acc_*` in m/s², `gyr_*` in
+/// rad/s; a `meta.json` beside it gives the rate, ranges and units) or MCAP (told by its
+/// magic bytes), as `gaitclip replay` reads it, in `acc_unit`/`gyr_unit` where given (over
+/// `meta.json`'s), checked. Returns the strides' columns (rows of the samples kept, a re-sent
+/// one dropped) and the summary's JSON.
 #[pyfunction]
-#[pyo3(signature = (path, rate_hz, detector, model, all_models, acc_range_g=None, gyro_range_dps=None))]
+#[pyo3(signature = (path, rate_hz, detector, model, all_models, acc_range_g=None, gyro_range_dps=None, acc_unit=None, gyr_unit=None, rate_overrides_stamps=false))]
 #[allow(clippy::too_many_arguments)]
 fn replay_path<'py>(
     py: Python<'py>,
@@ -344,10 +329,26 @@ fn replay_path<'py>(
     all_models: bool,
     acc_range_g: Option<f64>,
     gyro_range_dps: Option<f64>,
+    acc_unit: Option<&str>,
+    gyr_unit: Option<&str>,
+    rate_overrides_stamps: bool,
 ) -> PyResult<(Bound<'py, PyDict>, String)> {
     let o = options(detector, model, all_models)?;
     ranges_given(acc_range_g, gyro_range_dps)?;
-    let mut trace = py.detach(|| read(&path, rate_hz))?;
+    let given = units_named(acc_unit, gyr_unit)?;
+    let units = recording::declared_units(
+        &path,
+        acc_unit.map(|_| given.acc),
+        gyr_unit.map(|_| given.gyro),
+    )
+    .map_err(|e| PyValueError::new_err(e.to_string()))?;
+    let how = recording::ReadOptions {
+        rate_hz,
+        rate_overrides_stamps,
+        units,
+        front: Front::Python,
+    };
+    let mut trace = py.detach(|| read(&path, &how))?;
     trace.given.acc_g = acc_range_g.or(trace.given.acc_g);
     trace.given.gyro_dps = gyro_range_dps.or(trace.given.gyro_dps);
     run(py, trace, o, |row| row as u64)
@@ -362,21 +363,12 @@ fn not_found(path: &Path, source: &std::io::Error) -> PyErr {
     }
 }
 
-fn read(path: &Path, rate_hz: Option<f64>) -> PyResult<Trace> {
-    let is_mcap = path
-        .extension()
-        .is_some_and(|e| e.eq_ignore_ascii_case("mcap"));
-    if is_mcap {
-        mcap_io::read(path, rate_hz).map_err(|e| match &e {
-            McapError::Io { path, source } => not_found(path, source),
-            _ => PyValueError::new_err(e.to_string()),
-        })
-    } else {
-        csv_trace::read(path, rate_hz).map_err(|e| match &e {
-            CsvError::Io { path, source } => not_found(path, source),
-            _ => PyValueError::new_err(e.to_string()),
-        })
-    }
+fn read(path: &Path, o: &recording::ReadOptions) -> PyResult<Trace> {
+    recording::read(path, o).map_err(|e| match &e {
+        ReadError::Csv(CsvError::Io { path, source })
+        | ReadError::Mcap(McapError::Io { path, source }) => not_found(path, source),
+        _ => PyValueError::new_err(e.to_string()),
+    })
 }
 
 /// The detector and model names the core knows, and the default model.
@@ -396,5 +388,6 @@ fn _gaitclip(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(replay_path, m)?)?;
     m.add_function(wrap_pyfunction!(names, m)?)?;
     m.add("__version__", env!("CARGO_PKG_VERSION"))?;
+    m.add("LOW_RATE_HZ", replay::LOW_RATE_HZ)?;
     Ok(())
 }

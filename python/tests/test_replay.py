@@ -157,3 +157,37 @@ def test_bad_input_raises_the_right_exception(datasets, tmp_path):
     b = gaitclip.replay(good)
     assert len(a) == len(b)
     assert np.allclose(a["stride_length"], b["stride_length"], atol=0.002)
+
+
+def test_units_are_checked_on_every_path_and_declared_by_keyword(datasets, tmp_path):
+    """The rule is the command line's (Rust): an accelerometer in g is refused from a path and
+    from a DataFrame alike, naming the keyword; declared, it replays as the original."""
+    good = frame_of(datasets)
+    ref = gaitclip.replay(good)
+    in_g = good.copy()
+    in_g[["acc_x", "acc_y", "acc_z"]] = in_g[["acc_x", "acc_y", "acc_z"]] / 9.80665
+    with pytest.raises(ValueError, match="acc_unit='g'"):
+        gaitclip.replay(in_g)
+    assert np.allclose(gaitclip.replay(in_g, acc_unit="g")["stride_length"], ref["stride_length"], atol=0.002)
+    path = tmp_path / "walk.csv"
+    in_g.to_csv(path, index=False)
+    with pytest.raises(ValueError, match="acc_unit='g'"):
+        gaitclip.replay(path)
+    a = gaitclip.replay(path, acc_unit="g")
+    assert len(a) == len(ref)
+    # meta.json beside the file says it too.
+    (tmp_path / "meta.json").write_text('{"units": {"acc": "g"}}')
+    assert len(gaitclip.replay(path)) == len(ref)
+    with pytest.raises(ValueError, match="unknown acc unit"):
+        gaitclip.replay(good, acc_unit="furlongs")
+
+
+def test_a_rate_the_stamps_contradict_is_refused_and_a_low_rate_warns(datasets):
+    good = frame_of(datasets)
+    with pytest.raises(ValueError, match="rate_overrides_stamps=True"):
+        gaitclip.replay(good, 100.0)
+    # A rate within a host clock's drift of the stamps' is the caller's to give.
+    gaitclip.replay(good, 204.0)
+    # Every third row: 68 Hz, below the checked range: it replays, with the CLI's warning.
+    with pytest.warns(gaitclip.GaitclipWarning, match="below 100 Hz"):
+        gaitclip.replay(good.iloc[::3].reset_index(drop=True))

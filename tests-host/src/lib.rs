@@ -11,4 +11,5 @@ pub mod sim;
 pub mod train;
 
 pub mod pod;
+pub mod progress;
 pub mod replay;

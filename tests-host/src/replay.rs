@@ -24,7 +24,7 @@ use crate::io::trace::{Ranges, Trace};
 #[derive(Debug, thiserror::Error)]
 pub enum ReplayError {
     /// The rate is outside what the core supports.
-    #[error("sample rate {0} Hz is outside 25–1000 Hz")]
+    #[error("sample rate {0} Hz is outside 25–1000 Hz{hint}", hint = rate_hint(*.0))]
     Rate(f64),
     /// The trace has no samples.
     #[error("no samples")]
@@ -32,6 +32,21 @@ pub enum ReplayError {
     /// The timestamps go back by more than a re-sent sample's.
     #[error(transparent)]
     Time(#[from] TimeGoesBack),
+}
+
+/// Where a rate outside the core's is a sensor's in stamps of the wrong unit (`t_s` in ms
+/// or µs, or the rate given in kHz), the hint that says so.
+fn rate_hint(hz: f64) -> &'static str {
+    let ok = |r: f64| (25.0..=1000.0).contains(&r);
+    if ok(hz * 1e3) {
+        ": are the stamps in milliseconds? t_s is in seconds"
+    } else if ok(hz * 1e6) {
+        ": are the stamps in microseconds? t_s is in seconds"
+    } else if ok(hz * 1e9) {
+        ": are the stamps in nanoseconds? t_s is in seconds"
+    } else {
+        ""
+    }
 }
 
 /// What was done to a recording's samples before and while the core measured them: the
@@ -322,6 +337,49 @@ pub struct StrideReport {
     /// Its phase statistics (the features' input).
     #[serde(skip)]
     pub stats: StrideStats,
+}
+
+/// Every field of a stride's JSON record (`replay --json`, MCAP's `/strides`, Python's
+/// columns), in the order it is written, with what it holds: `gaitclip docs` writes the list
+/// into docs/host-tool.md, and a test holds it to the serialised record.
+pub const STRIDE_FIELDS: [(&str, &str); 29] = [
+    ("index", "stride number from 0 (strides that count)"),
+    ("start_s", "start: the stance instant the stride leaves, s in the trace's own clock"),
+    ("end_s", "end: the next stance instant, s"),
+    ("length_m", "length from the model named in `model`, m"),
+    ("model", "the length model behind `length_m`"),
+    ("detector", "the step detector: `cycle`, `stance` or `lu` (then `heel_off_s`/`toe_off_s` are the step's peak, `heel_strike_s`/`foot_flat_s` its valley)"),
+    ("lengths_m", "every model's length, m, by model name (only with `--all-models`)"),
+    ("zupt_m", "the strapdown (ZUPT) stride's horizontal displacement, m"),
+    ("heel_off_s", "heel-off, the end of the stance's foot-flat, s"),
+    ("toe_off_s", "toe-off, s"),
+    ("heel_strike_s", "heel-strike, s"),
+    ("foot_flat_s", "foot-flat after the heel-strike, s"),
+    ("climb_m", "height gained, m"),
+    ("stride_time_s", "one gait cycle, `end_s − start_s` on the sample grid, s"),
+    ("stance_time_s", "ground contact within the cycle, `stride_time_s − swing_time_s`, s"),
+    ("swing_time_s", "toe-off to heel-strike, s"),
+    ("stance_pct", "stance time per stride time, %"),
+    ("swing_pct", "swing time per stride time, %"),
+    ("gait_velocity_m_s", "length per stride time, m/s"),
+    ("cadence_spm", "steps per minute (two per cycle of the instrumented foot)"),
+    ("max_sensor_lift_m", "highest point of the sensor above its start, m"),
+    ("turning_angle_deg", "heading change over the movement, degrees, counter-clockwise seen from above"),
+    ("gait", "`walking`, `running`, `stairs_up`, `stairs_down` or `unknown`"),
+    ("swing_deg", "the foot's largest one-way rotation about its pitch axis in the movement, degrees"),
+    ("still_before_s", "since the last stride that counted: time at rest, s"),
+    ("moving_before_s", "since the last stride that counted: time moving without a step, s"),
+    ("valid", "false when the length was not measured or is not to be trusted (an `estimated` one still counts in the distance)"),
+    ("flags", "names of the flags set (docs/output.md lists them)"),
+    ("rejected", "not a stride field: a `{\"rejected\": …}` line is a movement the step check refused, with its `reason`"),
+];
+
+/// docs/host-tool.md's list of the JSON fields ([`STRIDE_FIELDS`]), as Markdown.
+pub fn fields_report(_datasets: &std::path::Path) -> anyhow::Result<String> {
+    Ok(STRIDE_FIELDS
+        .iter()
+        .map(|(name, what)| format!("- `{name}`: {what}\n"))
+        .collect())
 }
 
 /// Names of the stride flags, in bit order.

@@ -239,6 +239,37 @@ fn strides_equal_host_replay<const M: usize>(
             .any(|l| l.starts_with("still: gyro_bias_mdps=")),
         "no start-up calibration report"
     );
+    if dir == "boards/mps2-an386" && detector == Detector::Cycle {
+        // The README's and docs/output.md's transcripts are this run's (`cargo emulate`).
+        for doc in ["README.md", "docs/output.md"] {
+            transcript_printed(doc, "What the run prints", &out.lines);
+        }
+    }
+}
+
+/// Every line of `doc`'s transcript of a run (the first ```` ```text ```` block after the line
+/// holding `marker`; a `…` line stands for lines left out) is a line the run printed, figures
+/// and all: the docs show what the firmware prints, stack and sizes included.
+fn transcript_printed(doc: &str, marker: &str, log: &[String]) {
+    let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("..")
+        .join(doc);
+    let text = std::fs::read_to_string(&path).unwrap();
+    let block: Vec<&str> = text
+        .lines()
+        .skip_while(|l| !l.contains(marker))
+        .skip_while(|l| *l != "```text")
+        .skip(1)
+        .take_while(|l| *l != "```")
+        .collect();
+    assert!(block.len() >= 3, "{doc}: no transcript after {marker:?}");
+    for line in block.into_iter().filter(|l| l.trim() != "…") {
+        assert!(
+            log.iter().any(|l| l.trim_end() == line.trim_end()),
+            "{doc}: the transcript's line\n  {line}\nis not what the run printed:\n{}",
+            log.join("\n")
+        );
+    }
 }
 
 /// The demo walk with the still runs of `boards/common/src/replay_still.rs`, as the emulated
@@ -341,6 +372,14 @@ fn sleeps_and_wakes_as_the_host_model<const M: usize>(
     let elf = firmware::build_with(dir, bin, target, &["--features", "replay-sleep"], &env)
         .expect("firmware builds");
     let (out, on_target) = run_to_exit(&elf, machine);
+    if dir == "boards/mps2-an386" {
+        // docs/energy.md's transcript is this run's.
+        transcript_printed(
+            "docs/energy.md",
+            "cargo run --release --features replay-sleep",
+            &out.lines,
+        );
+    }
 
     let counts = gaitclip_host::sim::fixtures::firmware_trace_counts().unwrap();
     let ranges = Ranges::default();

@@ -9,10 +9,12 @@ use gaitclip::length::models::Model;
 use gaitclip::pipeline::config::Config;
 use gaitclip::pipeline::detectors::Detector;
 use gaitclip_host::eval::scoring;
+use gaitclip_host::io::recording::{self, ReadError};
 use gaitclip_host::io::trace::{Ranges, Trace};
+use gaitclip_host::io::units::{AccUnit, Front, GyroUnit, Units};
 use gaitclip_host::{
-    eval::length_eval, eval::matching, eval::tables, io::csv_trace, io::datasets, io::mcap_io,
-    replay, sim::fixtures, train::codegen, train::fit, train::training, train::training_set,
+    eval::length_eval, eval::matching, eval::tables, io::datasets, io::mcap_io, replay,
+    sim::fixtures, train::codegen, train::fit, train::training, train::training_set,
 };
 
 #[derive(Parser)]
@@ -46,8 +48,8 @@ enum Cmd {
         /// Length model for `length_m` (default: the firmware's; `lu_fuzzy` with `--detector lu`).
         #[arg(long, value_name = "NAME", value_parser = model_names())]
         model: Option<String>,
-        /// Add every model's length (`lengths_m` in JSON, a column each otherwise; stance
-        /// detector only).
+        /// Add every model's length (`lengths_m` in JSON, a line of them under each stride
+        /// otherwise), with the `cycle` or `stance` detector (`lu` has Lu's chain only).
         #[arg(long)]
         all_models: bool,
         /// Also write the samples and the strides to this MCAP file (opens in Foxglove).
@@ -62,6 +64,8 @@ enum Cmd {
         /// else ±2000 °/s); rails learnt as for the accelerometer.
         #[arg(long, value_name = "DPS")]
         gyro_range_dps: Option<f64>,
+        #[command(flatten)]
+        units: UnitArgs,
     },
     /// The Bluetooth foot pod on the host: the pod's own Bluetooth code over an HCI
     /// controller, serving the strides of a replayed recording as the board serves a walk.
@@ -91,6 +95,8 @@ enum Cmd {
         /// Strides and Bluetooth events as JSON lines.
         #[arg(long)]
         json: bool,
+        #[command(flatten)]
+        units: UnitArgs,
     },
     /// Score stride detection, gait events, phases and stance against the ground truth of
     /// dataset folders (`../shared/datasets/<name>`); prints Markdown tables.
@@ -257,6 +263,49 @@ enum Cmd {
     },
 }
 
+/// The units of a recording's values, where they are not the datasets' m/s² and rad/s, and
+/// whether a `--rate` given wins over the stamps.
+#[derive(clap::Args)]
+struct UnitArgs {
+    /// Replay at `--rate` even where the stamps' own rate is more than 10 % off it (without
+    /// this, that contradiction is an error: a wrong rate gives wrong lengths).
+    #[arg(long, requires = "rate")]
+    rate_overrides_stamps: bool,
+    /// The accelerometer's unit: `m/s^2`, `g` or `mg` (default: `units.acc` of a meta.json
+    /// beside the file, else m/s²). A recording whose stillest quarter does not read about 1 g in it is
+    /// refused, naming the unit it looks like.
+    #[arg(long, value_name = "UNIT", value_parser = acc_unit)]
+    acc_unit: Option<AccUnit>,
+    /// The gyroscope's unit: `rad/s` or `deg/s` (default: `units.gyr` of a meta.json beside
+    /// the file, else rad/s). A gyro faster than any IMU, or one that barely turns while the
+    /// foot steps, is refused, naming the unit it looks like.
+    #[arg(long, value_name = "UNIT", value_parser = gyr_unit)]
+    gyr_unit: Option<GyroUnit>,
+}
+
+impl UnitArgs {
+    /// The units declared on the command line, over `meta.json`'s (`None`: the file's own).
+    fn units(&self, trace: &Path) -> anyhow::Result<Option<Units>> {
+        Ok(recording::declared_units(
+            trace,
+            self.acc_unit,
+            self.gyr_unit,
+        )?)
+    }
+}
+
+fn acc_unit(s: &str) -> Result<AccUnit, String> {
+    Units::from_names(Some(s), None)
+        .map(|u| u.acc)
+        .map_err(|e| e.to_string())
+}
+
+fn gyr_unit(s: &str) -> Result<GyroUnit, String> {
+    Units::from_names(None, Some(s))
+        .map(|u| u.gyro)
+        .map_err(|e| e.to_string())
+}
+
 #[derive(Clone, Copy, clap::ValueEnum)]
 enum PhasesArg {
     MajorPairs,
@@ -334,6 +383,12 @@ fn status_of(e: &anyhow::Error) -> u8 {
     use gaitclip_host::io::csv_trace::CsvError;
     use gaitclip_host::io::mcap_io::McapError;
     for cause in e.chain() {
+        let cause: &(dyn std::error::Error + 'static) = match cause.downcast_ref::<ReadError>() {
+            Some(ReadError::Csv(c)) => c,
+            Some(ReadError::Mcap(m)) => m,
+            Some(ReadError::RateContradicts { .. }) => return status::BAD_INPUT,
+            None => cause,
+        };
         if let Some(c) = cause.downcast_ref::<CsvError>() {
             return match c {
                 CsvError::Io { .. } => status::NO_INPUT,
@@ -357,10 +412,25 @@ fn status_of(e: &anyhow::Error) -> u8 {
             return status::USAGE;
         }
     }
+    // A dataset folder of the user's that cannot be scored: not a file there, or bad input.
+    if e.downcast_ref::<datasets::DatasetError>().is_some() {
+        let missing = e.chain().any(|c| {
+            c.downcast_ref::<std::io::Error>()
+                .is_some_and(|io| io.kind() == std::io::ErrorKind::NotFound)
+        });
+        return if missing {
+            status::NO_INPUT
+        } else {
+            status::BAD_INPUT
+        };
+    }
     status::INTERNAL
 }
 
 fn main() -> ExitCode {
+    // A closed pipe (`gaitclip replay walk.csv | head -1`) ends the command as it ends `cat`:
+    // quietly, by SIGPIPE (status 141 in a shell), not by a panic in `println!`.
+    sigpipe::reset();
     let cli = Cli::parse();
     match run(cli) {
         Ok(()) => ExitCode::SUCCESS,
@@ -373,25 +443,67 @@ fn main() -> ExitCode {
                 status::USAGE => "usage",
                 _ => "internal error",
             };
-            eprintln!("gaitclip: {kind}: {e:#}");
+            eprintln!("gaitclip: {kind}: {}", causes(&e));
             ExitCode::from(status)
         }
     }
+}
+
+/// A stride as `replay` prints it without `--json`: its number, times, length, the four
+/// phases labelled (from the start's foot-flat to heel-off, heel-off to toe-off, the swing,
+/// heel-strike to the end's foot-flat), the stance and swing times (docs/host-tool.md), and
+/// its flags, on valid strides too.
+fn text_line(s: &replay::StrideReport) -> String {
+    let ms = |a: f64, b: f64| ((b - a) * 1e3).round();
+    let flags = match (s.valid, s.flags.is_empty()) {
+        (true, true) => String::new(),
+        (true, false) => format!("  flags {}", s.flags.join(",")),
+        (false, _) => format!("  INVALID ({})", s.flags.join(",")),
+    };
+    format!(
+        "stride {:3}  start {:8.3} s  dur {:5.3} s  length {:5.3} m  stance {:5.3} s  swing {:5.3} s  phases: flat {:.0} ms, push-off {:.0} ms, swing {:.0} ms, landing {:.0} ms{flags}",
+        s.index,
+        s.start_s,
+        s.end_s - s.start_s,
+        s.length_m,
+        s.stance_time_s,
+        s.swing_time_s,
+        ms(s.start_s, s.heel_off_s),
+        ms(s.heel_off_s, s.toe_off_s),
+        ms(s.toe_off_s, s.heel_strike_s),
+        ms(s.heel_strike_s, s.end_s),
+    )
+}
+
+/// The error and its causes, `: `-separated, each said once: a message that already ends
+/// with its cause's text (`{path}: {source}`) does not repeat it.
+fn causes(e: &anyhow::Error) -> String {
+    let mut out = String::new();
+    for cause in e.chain() {
+        let text = cause.to_string();
+        if out.ends_with(&text) {
+            continue;
+        }
+        if !out.is_empty() {
+            out.push_str(": ");
+        }
+        out.push_str(&text);
+    }
+    out
 }
 
 fn hci_transport(s: &str) -> Result<gaitclip_host::pod::Hci, String> {
     s.parse()
 }
 
-fn read_trace(path: &Path, rate: Option<f64>) -> anyhow::Result<Trace> {
-    let is_mcap = path
-        .extension()
-        .is_some_and(|e| e.eq_ignore_ascii_case("mcap"));
-    Ok(if is_mcap {
-        mcap_io::read(path, rate)?
-    } else {
-        csv_trace::read(path, rate)?
-    })
+fn read_trace(path: &Path, rate: Option<f64>, units: &UnitArgs) -> anyhow::Result<Trace> {
+    let o = recording::ReadOptions {
+        rate_hz: rate,
+        rate_overrides_stamps: units.rate_overrides_stamps,
+        units: units.units(path)?,
+        front: Front::CommandLine,
+    };
+    Ok(recording::read(path, &o)?)
 }
 
 fn run(cli: Cli) -> anyhow::Result<()> {
@@ -406,6 +518,7 @@ fn run(cli: Cli) -> anyhow::Result<()> {
             mcap_out,
             acc_range_g,
             gyro_range_dps,
+            units,
         } => {
             let detector = Detector::from_name(&detector).context("unknown detector")?;
             let model = match model.as_deref() {
@@ -421,7 +534,7 @@ fn run(cli: Cli) -> anyhow::Result<()> {
                 )
                 .into());
             }
-            let mut t = read_trace(&trace, rate)?;
+            let mut t = read_trace(&trace, rate, &units)?;
             for (given, name) in [
                 (acc_range_g, "--acc-range-g"),
                 (gyro_range_dps, "--gyro-range-dps"),
@@ -443,18 +556,7 @@ fn run(cli: Cli) -> anyhow::Result<()> {
                 if json {
                     println!("{}", serde_json::to_string(s)?);
                 } else {
-                    println!(
-                        "stride {:3}  start {:8.3} s  dur {:5.3} s  length {:5.3} m  phases {:3.0}/{:3.0}/{:3.0}/{:3.0} ms{}",
-                        s.index,
-                        s.start_s,
-                        s.end_s - s.start_s,
-                        s.length_m,
-                        (s.heel_off_s - s.start_s) * 1e3,
-                        (s.toe_off_s - s.heel_off_s) * 1e3,
-                        (s.heel_strike_s - s.toe_off_s) * 1e3,
-                        (s.end_s - s.heel_strike_s) * 1e3,
-                        if s.valid { String::new() } else { format!("  INVALID ({})", s.flags.join(",")) }
-                    );
+                    println!("{}", text_line(s));
                     if let Some(all) = &s.lengths_m {
                         let cols: Vec<String> =
                             all.iter().map(|(k, v)| format!("{k} {v:.3}")).collect();
@@ -518,12 +620,13 @@ fn run(cli: Cli) -> anyhow::Result<()> {
             battery_percent,
             detector,
             json,
+            units,
         } => {
             if !(speed.is_finite() && speed > 0.0) {
                 return Err(UsageError("--speed must be a positive number").into());
             }
             let detector = Detector::from_name(&detector).context("unknown detector")?;
-            let t = read_trace(&trace, rate)?;
+            let t = read_trace(&trace, rate, &units)?;
             gaitclip_host::pod::run(gaitclip_host::pod::PodOptions {
                 hci,
                 trace: t,
@@ -571,11 +674,19 @@ fn run(cli: Cli) -> anyhow::Result<()> {
             let mut side_by_side = Vec::new();
             let mut runs = Vec::new();
             let mut loaded = Vec::new();
+            let bar = gaitclip_host::progress::bar(
+                (datasets.len() * (detectors.len() + 1)) as u64 + 1,
+                "eval",
+            );
+            bar.enable_steady_tick(std::time::Duration::from_millis(500));
             for dir in &datasets {
+                bar.set_message(format!("loading {}", dir.display()));
                 let d = datasets::load(dir)?;
                 loaded.push(d.clone());
                 let mut tallies = Vec::new();
                 for (k, (which, det)) in detectors.iter().enumerate() {
+                    bar.set_message(format!("{}: the {} detector", d.name, which.name()));
+                    bar.inc(1);
                     // The default detector gets the rotations and the event table.
                     let r = scoring::evaluate(&d, det, if k == 0 { rotate } else { 0 }, seed)?;
                     tallies.push((*which, r.tally.clone()));
@@ -584,10 +695,18 @@ fn run(cli: Cli) -> anyhow::Result<()> {
                     }
                 }
                 side_by_side.push((d.name.clone(), tallies));
+                bar.set_message(format!("{}: every length model", d.name));
+                bar.inc(1);
                 runs.extend(training_set::run_dataset(&d)?);
             }
-            println!("The recordings as read (stamps, repeated samples, holes and what the core did with them):\n");
-            print!("{}", tables::data_table(&loaded)?);
+            bar.set_message("the recordings as read");
+            bar.inc(1);
+            let data_table = tables::data_table(&loaded)?;
+            bar.finish_and_clear();
+            println!("The folders and what their truth scores:\n");
+            print!("{}", tables::truth_table(&datasets, &loaded));
+            println!("\nThe recordings as read (stamps, repeated samples, holes and what the core did with them):\n");
+            print!("{data_table}");
             println!(
                 "\nStrides, gait events and phases by the default detector (`{}`):\n",
                 Detector::ALL[0].name()
@@ -599,6 +718,37 @@ fn run(cli: Cli) -> anyhow::Result<()> {
                 .collect();
             println!("\nStep detectors side by side (cycle: every-pace stance instants, the default; stance: Huang's variance + IQR stance detector; lu: Lu's peak-valley detection):\n");
             print!("{}", tables::detectors_table(&rows));
+            let trained_on: Vec<&str> = training_set::TRAINING_DATASETS
+                .into_iter()
+                .filter(|n| {
+                    runs.iter().any(|r| {
+                        r.dataset == *n
+                            && !training_set::samples(std::slice::from_ref(r)).is_empty()
+                    })
+                })
+                .collect();
+            if trained_on.len() < training_set::TRAINING_DATASETS.len() {
+                // Recordings of one's own (or one training dataset): nothing to train on and
+                // leave out, so the models the firmware ships are scored on them as they
+                // are, out of sample.
+                let shipped = length_eval::shipped_predictions(&runs);
+                let scores = length_eval::score(&runs, &shipped);
+                println!(
+                    "\nStride length by the models the firmware ships (trained on {}; out of sample on recordings they were not trained on). Leave-one-dataset-out needs both training datasets and is not run; no best model is named. Datasets without per-stride lengths: walked-distance error per trial:\n",
+                    training_set::TRAINING_DATASETS.join(" and ")
+                );
+                print!("{}", length_eval::table(&scores));
+                println!("\nWalked distance per trial, default model (datasets that give the walk's length):\n");
+                print!(
+                    "{}",
+                    length_eval::walked_table(
+                        &runs,
+                        &shipped,
+                        gaitclip::pipeline::config::DEFAULT_MODEL
+                    )
+                );
+                return Ok(());
+            }
             let hyper = fit::hyper_from(&gaitclip::length::trained::HYPER);
             let mut by = Vec::new();
             for v in length_eval::Validation::ALL {
@@ -664,8 +814,14 @@ fn run(cli: Cli) -> anyhow::Result<()> {
             }
         }
         Cmd::Train { datasets, out } => {
+            let bar = gaitclip_host::progress::bar(2, "train");
+            bar.enable_steady_tick(std::time::Duration::from_millis(500));
+            bar.set_message("replaying the training datasets");
             let runs = training_set::load_training(&datasets)?;
+            bar.inc(1);
+            bar.set_message("three grid searches of 360 SVR fits each, then every model");
             let t = training::train(&runs)?;
+            bar.finish_and_clear();
             std::fs::write(&out, codegen::rust_source(&t))
                 .with_context(|| format!("writing {}", out.display()))?;
             eprintln!(

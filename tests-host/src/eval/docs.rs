@@ -33,6 +33,7 @@ pub const GENERATORS: &[(&str, Generator)] = &[
     ("running", crate::eval::running::report),
     ("flags", crate::eval::flag_costs::report),
     ("bias", crate::eval::bias::report),
+    ("json-fields", crate::replay::fields_report),
 ];
 
 /// The subcommands of the `gaitclip` binary a marker may run as a whole command line: the

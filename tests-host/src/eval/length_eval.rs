@@ -40,6 +40,15 @@ use crate::train::training_set::{self, TrialRun, TRAINING_DATASETS};
 /// Predictions of every model for every stride of every run: `[run][stride][model]`, m.
 pub type Predictions = Vec<Vec<[f64; MODELS]>>;
 
+/// Every model's length for every stride of `runs` as the firmware computes it, with the
+/// models it ships ([`gaitclip::length::trained::PARAMS`]): out of sample on any recording
+/// but the training datasets'.
+pub fn shipped_predictions(runs: &[TrialRun]) -> Predictions {
+    runs.iter()
+        .map(|run| predict_run(run, &gaitclip::length::trained::PARAMS))
+        .collect()
+}
+
 fn predict_run(run: &TrialRun, params: &ModelParams) -> Vec<[f64; MODELS]> {
     run.fixed
         .iter()

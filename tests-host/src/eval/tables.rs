@@ -167,6 +167,29 @@ pub fn table(results: &[DatasetResult]) -> String {
     s
 }
 
+/// What each folder holds and what its truth scores ([`crate::io::datasets::Truth`]).
+pub fn truth_table(dirs: &[std::path::PathBuf], datasets: &[Dataset]) -> String {
+    let mut table = Table::new([
+        Column::from("dataset"),
+        Column::right("recordings"),
+        Column::right("reference strides or steps"),
+        Column::from("truth: what it scores"),
+    ]);
+    for (dir, d) in dirs.iter().zip(datasets) {
+        table.row([
+            d.name.clone(),
+            d.trials.len().to_string(),
+            d.trials
+                .iter()
+                .map(|t| t.references.len())
+                .sum::<usize>()
+                .to_string(),
+            crate::io::datasets::truth_of(dir).scores().to_string(),
+        ]);
+    }
+    table.render()
+}
+
 /// What the recordings' stamps and holes cost, per dataset: the replay's summaries
 /// ([`crate::replay::Summary`]) of every trial added up.
 pub fn data_table(datasets: &[Dataset]) -> Result<String> {

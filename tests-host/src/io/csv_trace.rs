@@ -6,6 +6,7 @@ use std::io::Write;
 use std::path::{Path, PathBuf};
 
 use crate::io::trace::{ImuSample, Trace};
+use crate::io::units::{self, Front, Units};
 
 /// The columns, in the order the datasets write them.
 pub const COLUMNS: [&str; 7] = ["t_s", "acc_x", "acc_y", "acc_z", "gyr_x", "gyr_y", "gyr_z"];
@@ -79,6 +80,15 @@ pub enum CsvError {
         /// The file.
         path: PathBuf,
     },
+    /// The values cannot be in the units declared for them ([`crate::io::units`]).
+    #[error("{path}: {unit}")]
+    Units {
+        /// The file.
+        path: PathBuf,
+        /// What the values look like, and how to declare it (in the message, not a cause
+        /// of its own: said once).
+        unit: units::UnitError,
+    },
     /// `meta.json` beside the file exists but is not usable.
     #[error("{path}: {message}")]
     Meta {
@@ -92,8 +102,21 @@ pub enum CsvError {
 /// Reads a CSV trace. The nominal rate comes from `rate_hz` if given, else from a
 /// `meta.json` beside the file (`sample_rate_hz`), else from the stamps
 /// ([`crate::io::clock::nominal_period`]). Re-sent samples (a stamp equal to the one before, or
-/// earlier by less than half a period) are dropped and counted in [`Trace::repeated`].
+/// earlier by less than half a period) are dropped and counted in [`Trace::repeated`]. The
+/// values are in the units of `meta.json`'s `units` (the datasets' m/s² and rad/s without
+/// one), converted and checked ([`units::check`]).
 pub fn read(path: &Path, rate_hz: Option<f64>) -> Result<Trace, CsvError> {
+    read_in(path, rate_hz, None, Front::CommandLine)
+}
+
+/// [`read`], the values in `units` where given (over `meta.json`'s); a unit that fails the
+/// check says how to declare another at `front`.
+pub fn read_in(
+    path: &Path,
+    rate_hz: Option<f64>,
+    units: Option<Units>,
+    front: Front,
+) -> Result<Trace, CsvError> {
     let text = fs::read(path).map_err(|source| CsvError::Io {
         path: path.to_owned(),
         source,
@@ -102,8 +125,16 @@ pub fn read(path: &Path, rate_hz: Option<f64>) -> Result<Trace, CsvError> {
         Some(r) => Some(r),
         None => meta_rate(path)?,
     };
+    let units = match units {
+        Some(u) => u,
+        None => meta_units(path)?,
+    };
     let rows = parse_rows(path, &text)?;
-    let (samples, repeated) = rows.without_repeats(path, rate_hz)?;
+    let (mut samples, repeated) = rows.without_repeats(path, rate_hz)?;
+    units::apply(&mut samples, units, front).map_err(|unit| CsvError::Units {
+        path: path.to_owned(),
+        unit,
+    })?;
     let rate_hz = match rate_hz {
         Some(r) => r,
         None => Trace::rate_from_timestamps(&samples).ok_or_else(|| CsvError::Empty {
@@ -118,53 +149,70 @@ pub fn read(path: &Path, rate_hz: Option<f64>) -> Result<Trace, CsvError> {
     })
 }
 
-/// The nominal ranges `acc_range_g` and `gyro_range_dps` of a `meta.json` beside the file,
-/// where it gives them.
-fn meta_ranges(csv: &Path) -> Result<crate::io::trace::GivenRanges, CsvError> {
-    let meta = csv.with_file_name("meta.json");
-    let Ok(text) = fs::read_to_string(&meta) else {
-        return Ok(Default::default());
-    };
-    let v: serde_json::Value = serde_json::from_str(&text).map_err(|e| CsvError::Meta {
-        path: meta.clone(),
-        message: e.to_string(),
-    })?;
-    let field = |name: &str| match v.get(name) {
-        None => Ok(None),
-        Some(r) => r
-            .as_f64()
-            .filter(|r| *r > 0.0)
-            .map(Some)
-            .ok_or(CsvError::Meta {
-                path: meta.clone(),
-                message: format!("{name} is not a positive number: {r}"),
-            }),
-    };
-    Ok(crate::io::trace::GivenRanges {
-        acc_g: field("acc_range_g")?,
-        gyro_dps: field("gyro_range_dps")?,
-    })
-}
-
-fn meta_rate(csv: &Path) -> Result<Option<f64>, CsvError> {
+/// The `meta.json` beside a CSV file, parsed, with its path; `None` where there is none.
+fn meta_json(csv: &Path) -> Result<Option<(PathBuf, serde_json::Value)>, CsvError> {
     let meta = csv.with_file_name("meta.json");
     let Ok(text) = fs::read_to_string(&meta) else {
         return Ok(None);
     };
-    let v: serde_json::Value = serde_json::from_str(&text).map_err(|e| CsvError::Meta {
+    let v = serde_json::from_str(&text).map_err(|e| CsvError::Meta {
         path: meta.clone(),
         message: e.to_string(),
     })?;
-    match v.get("sample_rate_hz") {
+    Ok(Some((meta, v)))
+}
+
+/// A positive number `name` of a `meta.json`, where it gives one.
+fn positive(meta: &Path, v: &serde_json::Value, name: &str) -> Result<Option<f64>, CsvError> {
+    match v.get(name) {
         None => Ok(None),
         Some(r) => r
             .as_f64()
             .filter(|r| *r > 0.0)
             .map(Some)
             .ok_or(CsvError::Meta {
-                path: meta,
-                message: format!("sample_rate_hz is not a positive number: {r}"),
+                path: meta.to_owned(),
+                message: format!("{name} is not a positive number: {r}"),
             }),
+    }
+}
+
+/// The units of a `meta.json` beside the file (`"units": {"acc": "g", "gyr": "deg/s"}`; a
+/// sensor not named is in the datasets' m/s² or rad/s).
+pub fn meta_units(csv: &Path) -> Result<Units, CsvError> {
+    let Some((meta, v)) = meta_json(csv)? else {
+        return Ok(Units::default());
+    };
+    let name = |sensor: &str| match v.get("units").and_then(|u| u.get(sensor)) {
+        None => Ok(None),
+        Some(n) => n.as_str().map(Some).ok_or(CsvError::Meta {
+            path: meta.clone(),
+            message: format!("units.{sensor} is not a string: {n}"),
+        }),
+    };
+    Units::from_names(name("acc")?, name("gyr")?).map_err(|e| CsvError::Meta {
+        path: meta.clone(),
+        message: e.to_string(),
+    })
+}
+
+/// The nominal ranges `acc_range_g` and `gyro_range_dps` of a `meta.json` beside the file,
+/// where it gives them.
+fn meta_ranges(csv: &Path) -> Result<crate::io::trace::GivenRanges, CsvError> {
+    let Some((meta, v)) = meta_json(csv)? else {
+        return Ok(Default::default());
+    };
+    Ok(crate::io::trace::GivenRanges {
+        acc_g: positive(&meta, &v, "acc_range_g")?,
+        gyro_dps: positive(&meta, &v, "gyro_range_dps")?,
+    })
+}
+
+/// The `sample_rate_hz` of a `meta.json` beside the file, where it gives one.
+fn meta_rate(csv: &Path) -> Result<Option<f64>, CsvError> {
+    match meta_json(csv)? {
+        None => Ok(None),
+        Some((meta, v)) => positive(&meta, &v, "sample_rate_hz"),
     }
 }
 

@@ -142,10 +142,53 @@ pub struct Dataset {
     pub trials: Vec<Trial>,
 }
 
-#[derive(Deserialize)]
+/// What a folder's `meta.json` may say (all optional: a folder of one's own needs none).
+#[derive(Deserialize, Default)]
 struct Meta {
-    name: String,
-    sample_rate_hz: f64,
+    name: Option<String>,
+    sample_rate_hz: Option<f64>,
+}
+
+/// A dataset folder that cannot be scored: the context of its error (a user's input, not
+/// gaitclip's fault).
+#[derive(Debug, thiserror::Error)]
+#[error("dataset folder {0}")]
+pub struct DatasetError(pub PathBuf);
+
+/// The files of a dataset folder that are not recordings: its truth and its own tables.
+const NOT_RECORDINGS: [&str; 5] = [
+    "strides.csv",
+    "events.csv",
+    "trials.csv",
+    ".reference.csv",
+    ".truth.csv",
+];
+
+/// The truth a folder holds, by its files, and what it scores.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Truth {
+    /// `strides.csv`: each stride's `start_idx`, `end_idx`, `length_m` and `flag` (`tc_idx`,
+    /// `ic_idx`, `pre_ic_idx` where known), by `trial`: detection, events, phases, lengths.
+    Strides,
+    /// `events.csv` (each step's `toe_off_idx`/`_s`, `heel_strike_idx`/`_s`, `foot`, `step`,
+    /// `in_uturn`) and `trials.csv` (each walk's span, U-turn, `distance_m`, `height_m`):
+    /// detection, events, walked distance.
+    Events,
+    /// Recordings only: replayed and described, nothing scored.
+    None,
+}
+
+impl Truth {
+    /// What the folder's truth scores, for the tables' readers.
+    pub const fn scores(self) -> &'static str {
+        match self {
+            Truth::Strides => "strides.csv: detection, events, phases, stride lengths",
+            Truth::Events => "events.csv + trials.csv: detection, events, walked distance",
+            Truth::None => {
+                "no truth (add strides.csv, or events.csv and trials.csv): recordings as read only"
+            }
+        }
+    }
 }
 
 fn read_rows(path: &Path) -> Result<Vec<BTreeMap<String, String>>> {
@@ -170,22 +213,66 @@ fn index(row: &BTreeMap<String, String>, k: &str, path: &Path) -> Result<u32> {
         .with_context(|| format!("{}: `{k}` = {v:?} is not an index", path.display()))
 }
 
-/// Loads a dataset folder of `../shared/datasets` (its layout is described there).
+/// Loads a dataset folder: one of `../shared/datasets` (its layout is described there) or
+/// one of the user's own in the same layout, with or without `meta.json` (the name is then
+/// the folder's, the rate the stamps'). Its truth is told by its files ([`Truth`]). A folder
+/// that cannot be read is an error in the [`DatasetError`] context.
 pub fn load(dir: &Path) -> Result<Dataset> {
+    load_folder(dir).with_context(|| DatasetError(dir.to_owned()))
+}
+
+/// The truth `dir` holds, by its files.
+pub fn truth_of(dir: &Path) -> Truth {
+    if dir.join("strides.csv").is_file() {
+        Truth::Strides
+    } else if dir.join("events.csv").is_file() && dir.join("trials.csv").is_file() {
+        Truth::Events
+    } else {
+        Truth::None
+    }
+}
+
+fn load_folder(dir: &Path) -> Result<Dataset> {
+    if !dir.exists() {
+        return Err(std::io::Error::new(std::io::ErrorKind::NotFound, "no such folder").into());
+    }
+    if !dir.is_dir() {
+        bail!("not a folder");
+    }
     let meta_path = dir.join("meta.json");
-    let meta: Meta = serde_json::from_slice(
-        &std::fs::read(&meta_path).with_context(|| format!("{}", meta_path.display()))?,
-    )
-    .with_context(|| format!("{}", meta_path.display()))?;
-    let trials = match meta.name.as_str() {
-        "gaitmap_walk" | "pyshoe_vicon" => load_strides(dir, &meta.name)?,
-        "ipol_gait_events" => load_ipol(dir)?,
-        "esangeni_run" => load_unlabelled(dir)?,
-        other => bail!("{}: unknown dataset {other:?}", dir.display()),
+    let meta: Meta = match std::fs::read(&meta_path) {
+        Ok(bytes) => {
+            serde_json::from_slice(&bytes).with_context(|| format!("{}", meta_path.display()))?
+        }
+        Err(_) => Meta::default(),
+    };
+    let name = match meta.name {
+        Some(n) => n,
+        None => dir
+            .canonicalize()
+            .ok()
+            .and_then(|d| d.file_name().map(|n| n.to_string_lossy().into_owned()))
+            .unwrap_or_else(|| "recordings".to_owned()),
+    };
+    let trials = match truth_of(dir) {
+        Truth::Strides => load_strides(dir, &name)?,
+        Truth::Events => load_ipol(dir)?,
+        Truth::None => load_unlabelled(dir)?,
+    };
+    let Some(first) = trials.first() else {
+        bail!("no recordings (`<trial>.csv` in the datasets' layout: t_s, acc_x … gyr_z)");
+    };
+    let rate_hz = match meta.sample_rate_hz {
+        Some(r) if r.is_finite() && r > 0.0 => r,
+        Some(r) => bail!(
+            "{}: sample_rate_hz {r} is not a positive number",
+            meta_path.display()
+        ),
+        None => crate::io::csv_trace::read(&first.csv, None)?.rate_hz,
     };
     Ok(Dataset {
-        name: meta.name,
-        rate_hz: meta.sample_rate_hz,
+        name,
+        rate_hz,
         trials,
     })
 }
@@ -268,14 +355,17 @@ fn load_strides(dir: &Path, name: &str) -> Result<Vec<Trial>> {
     Ok(trials)
 }
 
-/// A dataset without per-stride truth (`esangeni_run`): every `<trial>.csv` of the folder,
-/// whole, with no references.
+/// A dataset without per-stride truth (`esangeni_run`, a folder of one's own): every
+/// `<trial>.csv` of the folder but its tables, whole, with no references.
 fn load_unlabelled(dir: &Path) -> Result<Vec<Trial>> {
     let mut names: Vec<String> = std::fs::read_dir(dir)
         .with_context(|| format!("{}", dir.display()))?
         .filter_map(|e| e.ok())
         .filter_map(|e| {
             let n = e.file_name().to_string_lossy().into_owned();
+            if NOT_RECORDINGS.iter().any(|x| n.ends_with(x)) {
+                return None;
+            }
             n.strip_suffix(".csv").map(str::to_owned)
         })
         .collect();

@@ -9,6 +9,7 @@ use std::path::{Path, PathBuf};
 use serde::{Deserialize, Serialize};
 
 use crate::io::trace::{ImuSample, Trace};
+use crate::io::units::{self, Front, Units};
 use crate::replay::StrideReport;
 
 /// Schema name of gaitclip's own IMU messages (JSON).
@@ -47,6 +48,15 @@ pub enum McapError {
         path: PathBuf,
         /// The cause.
         source: std::io::Error,
+    },
+    /// The values cannot be in the units declared for them ([`crate::io::units`]).
+    #[error("{path}: {unit}")]
+    Units {
+        /// The file.
+        path: PathBuf,
+        /// What the values look like, and how to declare it (in the message, not a cause
+        /// of its own: said once).
+        unit: units::UnitError,
     },
     /// The file is not valid MCAP.
     #[error("{path}: not a readable MCAP file: {source}")]
@@ -348,12 +358,32 @@ fn check_uncompressed_chunks(path: &Path, bytes: &[u8]) -> Result<(), McapError>
 
 /// Reads the IMU samples of the first IMU channel (the first to carry a message) of an
 /// MCAP file. The rate is `rate_hz` if given, else the median interval of the timestamps.
+/// Both schemas carry m/s² and rad/s (gaitclip's by its schema, ROS 2's by REP 103); the
+/// values are checked in them ([`units::check`]).
 pub fn read(path: &Path, rate_hz: Option<f64>) -> Result<Trace, McapError> {
+    read_in(path, rate_hz, None, Front::CommandLine)
+}
+
+/// [`read`], the values in `units` where given (a recorder that wrote °/s or g into an SI
+/// schema); a unit that fails the check says how to declare another at `front`.
+pub fn read_in(
+    path: &Path,
+    rate_hz: Option<f64>,
+    units: Option<Units>,
+    front: Front,
+) -> Result<Trace, McapError> {
     let bytes = fs::read(path).map_err(|source| McapError::Io {
         path: path.to_owned(),
         source,
     })?;
-    decode(path, &bytes, rate_hz)
+    let mut trace = decode(path, &bytes, rate_hz)?;
+    units::apply(&mut trace.samples, units.unwrap_or_default(), front).map_err(|unit| {
+        McapError::Units {
+            path: path.to_owned(),
+            unit,
+        }
+    })?;
+    Ok(trace)
 }
 
 /// [`read`] on bytes already in memory; `path` is only for error messages.

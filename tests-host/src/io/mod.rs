@@ -5,5 +5,7 @@ pub mod csv_trace;
 pub mod datasets;
 pub mod mcap_io;
 pub mod rails;
+pub mod recording;
 pub mod resample;
 pub mod trace;
+pub mod units;
