@@ -535,7 +535,7 @@ pub fn encode_ros2_imu(s: &ImuSample, frame_id: &str) -> Vec<u8> {
     b.extend_from_slice(frame_id.as_bytes());
     b.push(0);
     let put = |b: &mut Vec<u8>, v: f64| {
-        while (b.len() - 4) % 8 != 0 {
+        while !(b.len() - 4).is_multiple_of(8) {
             b.push(0);
         }
         b.extend_from_slice(&v.to_le_bytes());
