@@ -24,7 +24,7 @@ use crate::io::trace::{Ranges, Trace};
 #[derive(Debug, thiserror::Error)]
 pub enum ReplayError {
     /// The rate is outside what the core supports.
-    #[error("sample rate {0} Hz is outside 25–1000 Hz{hint}", hint = rate_hint(*.0))]
+    #[error("sample rate {0:.4} Hz is outside 25–1000 Hz{hint}", hint = rate_hint(*.0))]
     Rate(f64),
     /// The trace has no samples.
     #[error("no samples")]

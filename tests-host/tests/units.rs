@@ -154,3 +154,72 @@ fn the_text_line_labels_its_phases_and_shows_flags() {
     let shown = strides.iter().filter(|l| l.contains("  flags ")).count();
     assert_eq!(shown, flagged_valid, "{out}");
 }
+
+/// The demo walk with its stamps times `k` (ms for 1000) or rounded to `decimals`.
+fn restamped(dir: &Path, k: f64, decimals: usize) -> PathBuf {
+    let text = std::fs::read_to_string(demo()).unwrap();
+    let mut out = String::new();
+    for (i, line) in text.lines().enumerate() {
+        match (i, line.split_once(',')) {
+            (0, _) | (_, None) => out += line,
+            (_, Some((t, rest))) => {
+                let t: f64 = t.parse().unwrap();
+                out += &format!("{:.*},{rest}", decimals, t * k);
+            }
+        }
+        out.push('\n');
+    }
+    let p = dir.join("walk.csv");
+    std::fs::write(&p, out).unwrap();
+    p
+}
+
+#[test]
+fn contradictions_in_the_clock_are_caught() {
+    let demo = demo();
+    // A rate the stamps contradict: refused, unless it is to win.
+    let (code, _, err) = gaitclip(&["replay", demo.to_str().unwrap(), "--rate", "100"]);
+    assert_eq!(code, Some(65), "{err}");
+    assert!(err.contains("--rate-overrides-stamps"), "{err}");
+    let (code, _, err) = gaitclip(&[
+        "replay",
+        demo.to_str().unwrap(),
+        "--rate",
+        "100",
+        "--rate-overrides-stamps",
+    ]);
+    assert_eq!(code, Some(0), "{err}");
+    // A host clock a few % off is the caller's to give.
+    let (code, _, err) = gaitclip(&["replay", demo.to_str().unwrap(), "--rate", "196"]);
+    assert_eq!(code, Some(0), "{err}");
+    // Stamps in ms: the hint.
+    let d = scratch("units-ms");
+    let p = restamped(&d, 1000.0, 3);
+    let (code, _, err) = gaitclip(&["replay", p.to_str().unwrap()]);
+    assert_eq!(code, Some(65), "{err}");
+    assert!(err.contains("are the stamps in milliseconds?"), "{err}");
+    // Stamps rounded to 0.1 ms at an odd rate: the rate is the sensor's, no false ppm.
+    let d2 = scratch("units-rounded");
+    let p = restamped(&d2, 200.0 / 204.8, 4);
+    let (code, out, err) = gaitclip(&["replay", p.to_str().unwrap()]);
+    assert_eq!(code, Some(0), "{err}");
+    let line = summary(&out);
+    let after = |key: &str| -> f64 {
+        let at = line
+            .find(key)
+            .unwrap_or_else(|| panic!("no {key} in {line}"))
+            + key.len();
+        line[at..]
+            .split(|c: char| c == ' ' || c == ',')
+            .next()
+            .unwrap()
+            .parse()
+            .unwrap()
+    };
+    let nominal = after("(nominal ");
+    assert!((nominal - 204.8).abs() < 0.05, "{line}");
+    let ppm = after("Hz, ");
+    assert!(ppm.abs() < 100.0, "{line}");
+    let _ = std::fs::remove_dir_all(d);
+    let _ = std::fs::remove_dir_all(d2);
+}

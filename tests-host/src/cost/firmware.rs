@@ -38,6 +38,10 @@ pub fn build_with(
         .env_remove("RUSTFLAGS")
         .env_remove("CARGO_ENCODED_RUSTFLAGS")
         .env_remove("CARGO_TARGET_DIR")
+        // Built as shipped: not through clippy-driver, which does not generate rustc's code
+        // (the test command lints the host crates through it).
+        .env_remove("RUSTC_WORKSPACE_WRAPPER")
+        .env_remove("CLIPPY_ARGS")
         .envs(
             env.iter()
                 .copied()
