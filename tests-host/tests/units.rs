@@ -210,7 +210,7 @@ fn contradictions_in_the_clock_are_caught() {
             .unwrap_or_else(|| panic!("no {key} in {line}"))
             + key.len();
         line[at..]
-            .split(|c: char| c == ' ' || c == ',')
+            .split([' ', ','])
             .next()
             .unwrap()
             .parse()
