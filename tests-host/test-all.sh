@@ -128,6 +128,15 @@ if ! python3 -c 'import ensurepip' >/dev/null 2>&1; then
   $sudo_cmd apt-get install -y -qq python3-venv
 fi
 mkdir -p "$root/tests-host/target"
+# The wheel's venv first (seconds), so that PyO3 is configured for its interpreter from the
+# start: the host build then compiles PyO3 as maturin will build the wheel, and maturin finds
+# it compiled (otherwise its interpreter and environment signature, which PyO3's build script
+# reads, differ from the host build's and PyO3 and the module compile twice).
+[ -x "$pyvenv/bin/python3" ] || python3 -m venv "$pyvenv"
+PYO3_PYTHON="$pyvenv/bin/python3"
+PYO3_ENVIRONMENT_SIGNATURE=$("$PYO3_PYTHON" -c \
+  'import sys; print("cpython-%d.%d-%dbit" % (sys.version_info[0], sys.version_info[1], 64 if sys.maxsize > 2**32 else 32))')
+export PYO3_PYTHON PYO3_ENVIRONMENT_SIGNATURE
 job_start "python tools (pip)" python_tools
 
 stage "toolchain and tools: $(grep '^channel' rust-toolchain.toml), QEMU, clang, flip-link, sccache"
