@@ -226,7 +226,9 @@ stage "Python: the gaitclip wheel (PyO3, maturin) and its tests (pytest, gaitmap
 # The wheel, built by maturin from this workspace in the dev profile (the crates the tests
 # above compiled; `pip install ./python` builds the release one) and installed over any
 # earlier one.
-PATH="$pyvenv/bin:$PATH" MATURIN_PEP517_ARGS="--profile dev" \
+# maturin runs cargo from python/, where tests-host/.cargo/config.toml (the host named as the
+# target) does not apply: it is named here, or every crate builds again in target/debug.
+PATH="$pyvenv/bin:$PATH" MATURIN_PEP517_ARGS="--profile dev --target $host" \
   "$pyvenv/bin/pip" install --quiet --disable-pip-version-check --no-build-isolation \
   --no-deps --force-reinstall "$root/python"
 GAITCLIP="$gaitclip_bin" GAITMAP_DATA_DIR="$gmdata" \
