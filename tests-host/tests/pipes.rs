@@ -2,9 +2,10 @@
 //! does (status 141 in a shell), never by a panic in `println!` (status 101 and a backtrace).
 //!
 //! Every subcommand's help, and the subcommands that print from a recording of our own in
-//! seconds, are run with their output closed before they write (deterministic: every write
-//! meets the closed pipe) and through a real `head -1`. The dataset reports print only after
-//! their minutes of work; the same first line of `main` covers them.
+//! seconds (`replay`, `energy`, `eval` on a folder of ours), are run with their output closed
+//! before they write (deterministic: every write meets the closed pipe) and through a real
+//! `head -1`. The other dataset reports print only after their minutes of work on the shared
+//! datasets; the same first line of `main` covers them.
 
 use std::io::{BufRead, BufReader};
 use std::os::unix::process::ExitStatusExt;
@@ -130,7 +131,13 @@ fn every_help_ends_by_sigpipe_on_a_closed_pipe() {
 #[test]
 fn output_into_a_closed_pipe_ends_by_sigpipe_without_a_panic() {
     let demo = demo();
-    let runs: [&[&str]; 5] = [
+    // A dataset report too: `eval` on a folder of our own (the demo walk, no truth).
+    let folder = std::env::temp_dir().join(format!("gaitclip-pipes-{}", std::process::id()));
+    std::fs::create_dir_all(&folder).unwrap();
+    std::fs::copy(&demo, folder.join("walk.csv")).unwrap();
+    let folder_arg = folder.to_str().unwrap().to_owned();
+    let runs: [&[&str]; 6] = [
+        &["eval", &folder_arg],
         &["replay", &demo],
         &["replay", &demo, "--json"],
         &["replay", &demo, "--detector", "stance", "--all-models"],
@@ -146,6 +153,7 @@ fn output_into_a_closed_pipe_ends_by_sigpipe_without_a_panic() {
         assert!(!line.is_empty(), "{args:?}");
         assert_quiet(args, status, &err);
     }
+    let _ = std::fs::remove_dir_all(folder);
 }
 
 /// The shell's own pipe, as the issue met it: `gaitclip replay … | head -1`, status 0 from the

@@ -215,6 +215,9 @@ pub fn report(inp: &Inputs) -> Result<String> {
     let host = crate::replay::core_strides(&counts, config);
     let host_mm: u64 = host.iter().map(|s| u64::from(s.length_mm)).sum();
 
+    // Four benchmark runs and every size build: minutes of cargo and QEMU.
+    let bar = crate::progress::bar(4 + BUILDS.len() as u64, "cost");
+    bar.enable_steady_tick(std::time::Duration::from_millis(500));
     let mut insns = Vec::new();
     for (target, machine, args) in [
         (
@@ -224,8 +227,10 @@ pub fn report(inp: &Inputs) -> Result<String> {
         ),
         ("thumbv6m-none-eabi", qemu::MACHINE_M0, &[][..]),
     ] {
+        bar.set_message(format!("the benchmark on {machine}"));
         let elf = crate::cost::firmware::build_with("boards/bench", "bench", target, args, &env)?;
         let r = run_bench(&elf, machine, &inp.plugin, &inp.scratch)?;
+        bar.inc(1);
         ensure!(
             r.samples as usize == counts.len(),
             "{machine}: the benchmark replayed {} of {} samples",
@@ -254,8 +259,10 @@ pub fn report(inp: &Inputs) -> Result<String> {
         ("thumbv7em-none-eabihf", qemu::MACHINE_M4),
         ("thumbv6m-none-eabi", qemu::MACHINE_M0),
     ] {
+        bar.set_message(format!("Lu's benchmark on {machine}"));
         let elf = build_for("boards/bench", "bench", target, Detector::PeakValley, &env)?;
         let r = run_bench_peak_valley(&elf, machine, &inp.plugin, &inp.scratch)?;
+        bar.inc(1);
         ensure!(
             (r.samples as usize, r.steps as usize, r.distance_mm)
                 == (counts.len(), lu_host.len(), lu_host_mm),
@@ -272,6 +279,8 @@ pub fn report(inp: &Inputs) -> Result<String> {
     let mut sizes = Vec::new();
     for b in BUILDS {
         let (label, machine) = (b.label, b.machine);
+        bar.set_message(format!("size of {label}"));
+        bar.inc(1);
         let elf = build_for(b.dir, b.bin, b.target, b.detector, &[])?;
         let size = size_of_elf(&std::fs::read(&elf)?)?;
         let stack = match machine {
@@ -293,6 +302,7 @@ pub fn report(inp: &Inputs) -> Result<String> {
         sizes.push((label, size, stack));
     }
 
+    bar.finish_and_clear();
     let estimates = std::fs::read_to_string(&inp.criterion_estimates).with_context(|| {
         format!(
             "reading {} (run benches/replay.rs)",
