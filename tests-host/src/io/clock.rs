@@ -115,12 +115,12 @@ pub fn drop_repeats(stamps: &[f64], period_s: f64) -> Result<Vec<usize>, TimeGoe
 /// Rows arrive in deliveries: one row each from a sensor's or a logger's clock, bursts of
 /// rows microseconds apart from a host's (rows closer than a tenth of the mean interval
 /// are one delivery). Between two deliveries the stamps advance by the rows of the later
-/// one times the period, plus the periods of any hole and the change of delay: the median
-/// of that advance per row, over all deliveries, is the period. Holes and delays touch few
-/// deliveries and leave the median where it is; the span per row would carry every lost
-/// sample, and the median interval of a host's bursts is microseconds. The period is then the
-/// mean advance per row over the deliveries within a quarter of that median, so that stamps
-/// rounded to a coarse tick still give the sensor's period.
+/// one times the period, plus the periods of any hole and the change of delay. The median
+/// of that advance per row, over all deliveries, is near the period: holes and delays touch
+/// few deliveries and leave it where it is (the span per row would carry every lost sample,
+/// and the median interval of a host's bursts is microseconds). The period is the mean
+/// advance per row over the deliveries within a quarter of that median: the median alone is
+/// one tick of stamps rounded to a coarse one (4.9 ms for 204.8 Hz at 0.1 ms).
 pub fn nominal_period(stamps: &[f64]) -> Option<f64> {
     let n = stamps.len();
     if n < 2 {

@@ -357,7 +357,7 @@ fn check_uncompressed_chunks(path: &Path, bytes: &[u8]) -> Result<(), McapError>
 }
 
 /// Reads the IMU samples of the first IMU channel (the first to carry a message) of an
-/// MCAP file. The rate is `rate_hz` if given, else the median interval of the timestamps.
+/// MCAP file. The rate is `rate_hz` if given, else the stamps' ([`crate::io::clock::nominal_period`]).
 /// Both schemas carry m/s² and rad/s (gaitclip's by its schema, ROS 2's by REP 103); the
 /// values are checked in them ([`units::check`]).
 pub fn read(path: &Path, rate_hz: Option<f64>) -> Result<Trace, McapError> {
