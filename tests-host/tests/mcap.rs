@@ -16,7 +16,7 @@ fn demo() -> gaitclip_host::io::trace::Trace {
 }
 
 fn tmp(name: &str) -> PathBuf {
-    std::env::temp_dir().join(format!("gaitclip-{}-{name}", std::process::id()))
+    std::env::temp_dir().join(format!("gaitclip-mcap-{}-{name}", std::process::id()))
 }
 
 #[test]

@@ -3,7 +3,7 @@
 //! shipped models are scored out of sample, leave-one-dataset-out says why it is not run;
 //! folders that cannot be scored are the user's errors (65, 66), never "internal".
 
-mod common;
+use crate::common;
 
 use common::{fixture, gaitclip, scratch};
 

@@ -4,7 +4,7 @@
 //! the unit is declared (flag or `meta.json`). An MCAP file named `.csv` is read as MCAP; an
 //! error's cause is printed once.
 
-mod common;
+use crate::common;
 
 use std::path::{Path, PathBuf};
 
