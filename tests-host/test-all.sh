@@ -28,8 +28,9 @@
 #   compiler's output for given inputs, so it cannot change what is compiled or tested.
 # - Side by side where a core would idle: the Python tools install while Rust compiles, the
 #   firmware builds beside the host tools (fat LTO links on one core), the Bluetooth test
-#   (real-time replays) beside the host tests and the wheel, and the host tests on every
-#   core at once (cargo-nextest, where the machine has it). A job's output is printed whole
+#   (real-time replays) from the moment the CLI is built, the wheel and its tests beside the
+#   host tests, and the host tests on every core at once (cargo-nextest, where the machine
+#   has it). A job's output is printed whole
 #   when it ends, under its name; a failed job's output is printed and the script stops.
 set -euo pipefail
 root=$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)
@@ -175,17 +176,21 @@ firmware() {
   local dir
   # The emulated boards and the benchmark first: the host tests run them in QEMU and wait for
   # cargo's lock on the build folder while this job holds it.
+  # The boards the tests do not run (they flash real hardware) build into a folder of their
+  # own, so that the tests' firmware builds in target/ do not wait for cargo's lock on it.
   for dir in "$root"/boards/{mps2-an386,microbit,bench}/ "$root"/boards/*/; do
     case " ${built:-} " in *" $dir "*) continue ;; esac
     built="${built:-} $dir"
     [ -f "$dir/.cargo/config.toml" ] || continue
-    local t0=$SECONDS
+    local t0=$SECONDS target_dir="$root/target"
+    case "$dir" in */mps2-an386/ | */microbit/ | */bench/) ;; *) target_dir="$root/target/flash" ;; esac
     # The firmware is built by rustc itself, as `cargo emulate` and a flash build it:
     # clippy-driver does not generate the same code (the M4 firmware's stack high-water mark
     # was 4572 B through it, 4764 B as shipped), so the boards are linted by a check of their
     # own (no code generated) and built without it.
-    (cd "$dir" && env -u RUSTC_WORKSPACE_WRAPPER -u CLIPPY_ARGS cargo build --release --quiet)
-    (cd "$dir" && env -u RUSTC_WORKSPACE_WRAPPER -u CLIPPY_ARGS \
+    (cd "$dir" && env -u RUSTC_WORKSPACE_WRAPPER -u CLIPPY_ARGS CARGO_TARGET_DIR="$target_dir" \
+      cargo build --release --quiet)
+    (cd "$dir" && env -u RUSTC_WORKSPACE_WRAPPER -u CLIPPY_ARGS CARGO_TARGET_DIR="$target_dir" \
       cargo clippy --release --quiet -- -D warnings)
     echo "${dir#"$root"/}: built and linted in $((SECONDS - t0)) s"
   done
@@ -196,22 +201,56 @@ cd "$root/tests-host"
 # The host tests with cargo-nextest where the machine has it (every test binary's tests on
 # every core at once), else with cargo test; the same tests either way.
 if cargo nextest --version >/dev/null 2>&1; then runner=nextest; else runner=cargo-test; fi
+# The Bluetooth foot pod (gaitclip pod) against Bumble's virtual controller and a Bumble
+# central replays in real time and needs only the CLI and Bumble: it starts as soon as cargo
+# reports the CLI built, beside the rest of the build and the tests.
+gaitclip_bin="$root/tests-host/target/$host/debug/gaitclip"
+bluetooth() {
+  # Bumble comes from the pip job; its closing line says it has ended.
+  while [ ! -f "$jobs_dir/python tools (pip).time" ]; do sleep 1; done
+  [ -x "$venv/bin/python" ] || { echo "the Python tools did not install (their job says why)"; return 1; }
+  GAITCLIP="$gaitclip_bin" "$venv/bin/python" -m pytest -q -p no:cacheprovider "$root/tests-host/ble"
+}
+ble="Bluetooth: the foot pod against Bumble (pytest)"
 # Every target of the host workspace (the library, the CLI, the QEMU plugin, the Python
-# module, the tests and the benchmark), built once for the tests and linted on the way.
-cargo build --workspace --all-targets --quiet
+# module, the tests and the benchmark), built once for the tests and linted on the way;
+# cargo's report of each artefact (JSON, on stdout; its diagnostics go to stderr as usual)
+# says when the CLI is there.
+ble_started=""
+exec {build_fd}< <(cargo build --workspace --all-targets --quiet --message-format=json-render-diagnostics)
+build_pid=$!
+while IFS= read -r -u "$build_fd" line; do
+  case "$line" in
+    *'"reason":"compiler-artifact"'*"\"executable\":\"$gaitclip_bin\""*)
+      [ -n "$ble_started" ] || { job_start "$ble" bluetooth; ble_started=1; } ;;
+  esac
+done
+exec {build_fd}<&-
+# cargo's own exit status: a failed build stops the script here.
+wait "$build_pid"
+[ -n "$ble_started" ] || job_start "$ble" bluetooth
 if [ "$runner" = nextest ]; then
   cargo nextest run --workspace --no-run
 else
   cargo test --workspace --no-run
 fi
 
-stage "tests-host: the host tests (and the firmware and Bluetooth beside them)"
+stage "tests-host: the host tests (the firmware, Bluetooth and the Python wheel beside them)"
 job_wait "python tools (pip)"
-# The Bluetooth foot pod (gaitclip pod) against Bumble's virtual controller and a Bumble
-# central: replays in real time, so it runs beside the host tests.
-gaitclip_bin="$root/tests-host/target/$host/debug/gaitclip"
-job_start "Bluetooth: the foot pod against Bumble (pytest)" \
-  env GAITCLIP="$gaitclip_bin" "$venv/bin/python" -m pytest -q -p no:cacheprovider "$root/tests-host/ble"
+# The wheel, built by maturin from this workspace in the dev profile (the crates the tests
+# above compiled; `pip install ./python` builds the release one) and installed over any
+# earlier one, then its pytest suite beside gaitmap: beside the host tests.
+# maturin runs cargo from python/, where tests-host/.cargo/config.toml (the host named as the
+# target) does not apply: it is named here, or every crate builds again in target/debug.
+python_wheel() {
+  PATH="$pyvenv/bin:$PATH" MATURIN_PEP517_ARGS="--profile dev --target $host" \
+    "$pyvenv/bin/pip" install --quiet --disable-pip-version-check --no-build-isolation \
+    --no-deps --force-reinstall "$root/python"
+  GAITCLIP="$gaitclip_bin" GAITMAP_DATA_DIR="$gmdata" \
+    "$pyvenv/bin/python" -m pytest -q -p no:cacheprovider "$root/python/tests"
+}
+wheel="Python: the gaitclip wheel (PyO3, maturin) and its tests (pytest, gaitmap beside it)"
+job_start "$wheel" python_wheel
 if [ "$runner" = nextest ]; then
   cargo nextest run --workspace --no-fail-fast --status-level fail --final-status-level slow \
     2>&1 | tee -a "$log"
@@ -222,20 +261,9 @@ fi
 # take the other, and are waited for here.
 job_wait "firmware: every board and the benchmark"
 
-stage "Python: the gaitclip wheel (PyO3, maturin) and its tests (pytest, gaitmap beside it)"
-# The wheel, built by maturin from this workspace in the dev profile (the crates the tests
-# above compiled; `pip install ./python` builds the release one) and installed over any
-# earlier one.
-# maturin runs cargo from python/, where tests-host/.cargo/config.toml (the host named as the
-# target) does not apply: it is named here, or every crate builds again in target/debug.
-PATH="$pyvenv/bin:$PATH" MATURIN_PEP517_ARGS="--profile dev --target $host" \
-  "$pyvenv/bin/pip" install --quiet --disable-pip-version-check --no-build-isolation \
-  --no-deps --force-reinstall "$root/python"
-GAITCLIP="$gaitclip_bin" GAITMAP_DATA_DIR="$gmdata" \
-  "$pyvenv/bin/python" -m pytest -q -p no:cacheprovider "$root/python/tests" 2>&1 | tee -a "$log"
-
-stage "Bluetooth (waiting for it)"
-job_wait "Bluetooth: the foot pod against Bumble (pytest)"
+stage "the jobs beside (waiting for them)"
+job_wait "$wheel"
+job_wait "$ble"
 stage ""
 
 # The closing lines: how long each stage took, then one line over every test binary and
