@@ -170,7 +170,19 @@ pub fn run(opts: PodOptions) -> Result<()> {
         .enable_all()
         .build()
         .context("tokio runtime")?;
-    rt.block_on(run_async(opts))
+    // The pod runs as a task of its own, not as `block_on`'s future: embassy-sync and
+    // trouble-host re-register their wakers on every poll and wake the old one when
+    // `Waker::will_wake` says it differs, and the clones of tokio's `block_on` waker compare
+    // unequal to it (its vtable is instantiated in more than one codegen unit), so each poll
+    // woke the pod again: more than a core spent polling (perf, gdb: `WakerRegistration::
+    // register` in embassy-sync's channel and trouble-host's connection manager). A task's
+    // waker has one vtable.
+    let local = tokio::task::LocalSet::new();
+    local.block_on(&rt, async move {
+        tokio::task::spawn_local(run_async(opts))
+            .await
+            .context("the pod's task")?
+    })
 }
 
 async fn run_async(opts: PodOptions) -> Result<()> {
@@ -270,8 +282,11 @@ async fn serve(
     Ok(())
 }
 
-/// The recording through the core, sample by sample at its own pace over `opts.speed`,
-/// every stride printed and handed to the link.
+/// How far ahead of its time a sample may be fed: the replay wakes at most once per this.
+const PACE_BURST: Duration = Duration::from_millis(10);
+
+/// The recording through the core, sample by sample at its own pace over `opts.speed`
+/// (in bursts of at most [`PACE_BURST`]), every stride printed and handed to the link.
 async fn feed(prepared: &Prepared, config: Config, opts: &PodOptions) {
     let clock = &prepared.clock;
     let mut p = Pipeline::new(config);
@@ -307,8 +322,14 @@ async fn feed(prepared: &Prepared, config: Config, opts: &PodOptions) {
                 emit(st);
             }
         }
-        let due = (clock.t_s(p.next_index()) - t0).max(0.0) / opts.speed;
-        tokio::time::sleep_until(start + Duration::from_secs_f64(due)).await;
+        let due =
+            start + Duration::from_secs_f64((clock.t_s(p.next_index()) - t0).max(0.0) / opts.speed);
+        // Samples are fed in bursts of up to PACE_BURST, as the board's sampler drains its
+        // FIFO, not one timer wake-up per sample: at 200 Hz × 30 (the Bluetooth tests'
+        // soak) that was 6 000 wake-ups a second and more than a core spent waking.
+        if due > tokio::time::Instant::now() + PACE_BURST {
+            tokio::time::sleep_until(due).await;
+        }
         if let Some(st) = p.process(s) {
             emit(st);
         }
