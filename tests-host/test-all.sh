@@ -176,21 +176,17 @@ firmware() {
   local dir
   # The emulated boards and the benchmark first: the host tests run them in QEMU and wait for
   # cargo's lock on the build folder while this job holds it.
-  # The boards the tests do not run (they flash real hardware) build into a folder of their
-  # own, so that the tests' firmware builds in target/ do not wait for cargo's lock on it.
   for dir in "$root"/boards/{mps2-an386,microbit,bench}/ "$root"/boards/*/; do
     case " ${built:-} " in *" $dir "*) continue ;; esac
     built="${built:-} $dir"
     [ -f "$dir/.cargo/config.toml" ] || continue
-    local t0=$SECONDS target_dir="$root/target"
-    case "$dir" in */mps2-an386/ | */microbit/ | */bench/) ;; *) target_dir="$root/target/flash" ;; esac
+    local t0=$SECONDS
     # The firmware is built by rustc itself, as `cargo emulate` and a flash build it:
     # clippy-driver does not generate the same code (the M4 firmware's stack high-water mark
     # was 4572 B through it, 4764 B as shipped), so the boards are linted by a check of their
     # own (no code generated) and built without it.
-    (cd "$dir" && env -u RUSTC_WORKSPACE_WRAPPER -u CLIPPY_ARGS CARGO_TARGET_DIR="$target_dir" \
-      cargo build --release --quiet)
-    (cd "$dir" && env -u RUSTC_WORKSPACE_WRAPPER -u CLIPPY_ARGS CARGO_TARGET_DIR="$target_dir" \
+    (cd "$dir" && env -u RUSTC_WORKSPACE_WRAPPER -u CLIPPY_ARGS cargo build --release --quiet)
+    (cd "$dir" && env -u RUSTC_WORKSPACE_WRAPPER -u CLIPPY_ARGS \
       cargo clippy --release --quiet -- -D warnings)
     echo "${dir#"$root"/}: built and linted in $((SECONDS - t0)) s"
   done
