@@ -39,6 +39,7 @@ from . import _gaitclip
 
 __all__ = [
     "replay",
+    "cohort",
     "GaitclipStrides",
     "GaitclipWarning",
     "DETECTORS",
@@ -318,3 +319,7 @@ class GaitclipStrides:
         self.parameters_ = {s: r[2] for s, r in results.items()}
         self.summary_ = {s: r[3] for s, r in results.items()}
         return self
+
+
+# A cohort of recordings on Dask (its own module; Dask is imported only when it runs).
+from .cohort import cohort  # noqa: E402

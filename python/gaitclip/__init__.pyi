@@ -1,7 +1,7 @@
 """gaitclip for Python: the shoe-clip firmware's own stride detector and length."""
 
 from os import PathLike
-from typing import Any, Dict, List, Mapping, Optional, Union
+from typing import Any, Dict, Iterable, List, Mapping, Optional, Union
 
 import pandas as pd
 
@@ -51,3 +51,12 @@ class GaitclipStrides:
         *,
         sampling_rate_hz: float,
     ) -> "GaitclipStrides": ...
+
+def cohort(
+    paths_or_glob: Union[str, PathLike[str], Iterable[Union[str, PathLike[str]]]],
+    out: Union[str, PathLike[str]],
+    client: Optional[Any] = None,
+    *,
+    progress: Optional[bool] = None,
+    **replay_kwargs: Any,
+) -> pd.DataFrame: ...
