@@ -231,6 +231,14 @@ enum Cmd {
         #[arg(default_value = "../../shared/datasets")]
         datasets: PathBuf,
     },
+    /// The walk-jog-run-sprint courses of `esangeni_course` against their geometry: the
+    /// total, the forward, backward and sideways parts (split by the foot's heading), strides
+    /// by gait class, |climb| per stride, flags.
+    Course {
+        /// The folder holding the datasets (`../shared/datasets`).
+        #[arg(default_value = "../../shared/datasets")]
+        datasets: PathBuf,
+    },
     /// What each stride flag costs: the flags as they occur on the datasets against their
     /// references, and made on purpose (holes, clipping) against the strides undegraded.
     Flags {
@@ -874,6 +882,9 @@ fn run(cli: Cli) -> anyhow::Result<()> {
         }
         Cmd::Running { datasets } => {
             print!("{}", gaitclip_host::eval::running::report(&datasets)?);
+        }
+        Cmd::Course { datasets } => {
+            print!("{}", gaitclip_host::eval::course::report(&datasets)?);
         }
         Cmd::Daily { dir } => print!("{}", gaitclip_host::eval::daily::report(&dir)?),
         Cmd::Flags { datasets } => {
