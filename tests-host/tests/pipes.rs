@@ -105,6 +105,7 @@ fn every_subcommand_is_listed_here() {
         "clipping",
         "rates",
         "running",
+        "course",
         "flags",
         "daily",
         "docs",

@@ -206,15 +206,22 @@ pub fn data_table(datasets: &[Dataset]) -> Result<String> {
         Column::right("bridged strides"),
         Column::right("gap strides"),
         Column::from("trials re-timed (stamps off the clock)"),
+        Column::from(CLIMB_COLUMN),
     ]);
     for d in datasets {
         let mut t = crate::replay::Summary::default();
         let (mut holed, mut retimed) = (0, 0);
+        let mut climbs = Vec::new();
         for trial in &d.trials {
             let trace = csv_trace::read(&trial.csv, Some(d.rate_hz))?;
             let p = crate::replay::prepare(&trace, Ranges::default())
                 .with_context(|| format!("{}", trial.csv.display()))?;
-            let (_, one) = p.run(p.config(Ranges::default()));
+            let (strides, one) = p.run(p.config(Ranges::default()));
+            climbs.extend(
+                strides
+                    .iter()
+                    .map(|(s, _)| s.climb_mm.unsigned_abs() as f64 / 1000.0),
+            );
             holed += (one.holes > 0) as usize;
             retimed += (one.retimed_stamps > 0) as usize;
             t.add(&one);
@@ -237,9 +244,30 @@ pub fn data_table(datasets: &[Dataset]) -> Result<String> {
             t.bridged_strides.to_string(),
             t.gap_strides.to_string(),
             format!("{retimed} ({})", t.retimed_stamps),
+            climb_cell(&climbs),
         ]);
     }
     Ok(table.render())
+}
+
+/// The climb check's column: a stride's height gained is integration error on the level and
+/// a riser or two on stairs, so its spread says how physical the strides are.
+const CLIMB_COLUMN: &str = "|climb| per stride, m: median / p95 / max (strides over 0.3 m)";
+
+fn climb_cell(climbs_m: &[f64]) -> String {
+    if climbs_m.is_empty() {
+        return "–".into();
+    }
+    format!(
+        "{:.3} / {:.3} / {:.3} ({})",
+        crate::eval::stats::median(climbs_m),
+        crate::eval::stats::quantile(climbs_m, 0.95),
+        climbs_m.iter().copied().fold(0.0, f64::max),
+        climbs_m
+            .iter()
+            .filter(|&&c| c > crate::eval::course::CLIMB_CHECK_M)
+            .count()
+    )
 }
 
 /// Step detection side by side: one row per dataset and detector (the `Tally` of each, as
