@@ -5,15 +5,12 @@
 use std::path::PathBuf;
 use std::process::Command;
 
+use crate::common;
+
+/// `gaitclip args`: its exit status and what it said on stderr.
 fn gaitclip(args: &[&str]) -> (Option<i32>, String) {
-    let out = Command::new(env!("CARGO_BIN_EXE_gaitclip"))
-        .args(args)
-        .output()
-        .unwrap();
-    (
-        out.status.code(),
-        String::from_utf8_lossy(&out.stderr).into_owned(),
-    )
+    let (code, _, stderr) = common::gaitclip(args);
+    (code, stderr)
 }
 
 fn tmp(name: &str, bytes: &[u8]) -> PathBuf {
