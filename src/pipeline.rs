@@ -222,7 +222,7 @@ impl<D: StepDetector> Pipeline<D> {
             counted: 0,
             numbered: [(u32::MAX, u32::MAX); 2],
             rejected: Rejected {
-                by_reason: [0; 3],
+                by_reason: [0; 4],
                 unchecked: 0,
             },
             between: BetweenTotals {
@@ -684,7 +684,7 @@ impl<D: StepDetector> Pipeline<D> {
             self.rejected.unchecked = self.rejected.unchecked.saturating_add(1);
         } else if self.check_steps && !s.flags.has(StrideFlags::GAP) {
             let verdict = evidence.judge(Path::of(&s));
-            self.ledger.judged(&s, &evidence, verdict.is_ok());
+            self.ledger.judged(&s, &evidence, verdict);
             if let Err(why) = verdict {
                 let n = &mut self.rejected.by_reason[why as usize];
                 *n = n.saturating_add(1);

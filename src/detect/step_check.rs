@@ -27,6 +27,13 @@
 //!   turns it (2–4 rad/s; 2.7 the median of `hugadb_daily`'s rides): [`RUN_SWING_MRADPS`]
 //!   stands for the rest.
 //! - **A step takes the time of a step.** A movement longer than [`STEP_MAX_MS`] is not one.
+//! - **A step starts from standing.** A foot on a pedal pauses at the top and bottom of
+//!   its circle for a tenth of a second at a time, still by the rest test, and then moves as
+//!   a shuffle or a stair step would. A foot that has moved for [`UNSETTLED_MS`] since its
+//!   last step without standing still for [`STANCE_MIN_MS`] in all that time has not stood
+//!   on the ground: its next movement is not a step unless it is a runner's swing. A walk
+//!   that begins straight out of such a movement loses its first stride, not the walk: a
+//!   movement refused so ends the unsettled time, and the next is judged afresh.
 //!
 //! **What it keeps.** Per sample, O(1) and integer, fed by the pipeline whatever the
 //! detector: the runs of rest decisions (a ring of the last [`RESTS`], blips under
@@ -85,6 +92,15 @@ pub const REST_NEAR_MS: u32 = 300;
 pub const REST_BLIP_MS: u32 = 60;
 /// Rotations smaller than this are not kept, degrees (a stride's swing is never one).
 pub const LOBE_KEEP_DEG: u32 = 5;
+/// Moving this long since the last step (or since a movement refused for it) without
+/// [`STANCE_MIN_MS`] at rest in all that time, ms, the foot is not standing on the ground:
+/// a few strides' time. A walker's foot rests in every stance (0.1–0.6 s), a standing or
+/// seated one for seconds; a pedalling foot never longer than a dead centre's pause. The rest
+/// is counted as far back as the ledger's last [`RESTS`] rest runs reach.
+pub const UNSETTLED_MS: u32 = 5000;
+/// …the rest a foot standing on the ground shows in that time, ms: a standing start's
+/// stance lasts 0.5 s or more; a pedal's dead centres 0.02–0.2 s each.
+pub const STANCE_MIN_MS: u32 = 500;
 /// Rest runs kept: a walking stride has one, so these cover the few seconds a detector
 /// reports late.
 pub const RESTS: usize = 8;
@@ -103,11 +119,20 @@ pub enum Rejection {
     /// The foot moved for longer than a step takes ([`STEP_MAX_MS`]): pedalling or fidgeting
     /// that a detector took for one long stride.
     TooLong = 2,
+    /// A step's movement, but the foot had not stood on the ground before it: moving for
+    /// [`UNSETTLED_MS`] since the last step with under [`STANCE_MIN_MS`] at rest
+    /// (pedalling, between its dead centres).
+    NoStance = 3,
 }
 
 impl Rejection {
     /// Every reason, in the order of [`Rejected::by_reason`].
-    pub const ALL: [Rejection; 3] = [Rejection::NoRest, Rejection::NoSwing, Rejection::TooLong];
+    pub const ALL: [Rejection; 4] = [
+        Rejection::NoRest,
+        Rejection::NoSwing,
+        Rejection::TooLong,
+        Rejection::NoStance,
+    ];
 
     /// The name the logs and `--json` use.
     pub const fn name(self) -> &'static str {
@@ -115,6 +140,7 @@ impl Rejection {
             Rejection::NoRest => "no_rest",
             Rejection::NoSwing => "no_swing",
             Rejection::TooLong => "too_long",
+            Rejection::NoStance => "no_stance",
         }
     }
 }
@@ -123,7 +149,7 @@ impl Rejection {
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub struct Rejected {
     /// Counts by reason.
-    pub by_reason: [u32; 3],
+    pub by_reason: [u32; 4],
     /// Strides let through unjudged: their detector reports them later than the ledger
     /// reaches back ([`crate::detect::seam::StepDetector::reports_late`]).
     pub unchecked: u32,
@@ -135,6 +161,7 @@ impl Rejected {
         self.by_reason[0]
             .saturating_add(self.by_reason[1])
             .saturating_add(self.by_reason[2])
+            .saturating_add(self.by_reason[3])
     }
 }
 
@@ -201,6 +228,9 @@ pub struct StepEvidence {
     pub rest_after: bool,
     /// The movement lasted no longer than [`STEP_MAX_MS`].
     pub short_enough: bool,
+    /// The foot stood on the ground or stepped in the seconds before it: not moving for
+    /// [`UNSETTLED_MS`] since the last step without [`STANCE_MIN_MS`] at rest.
+    pub settled: bool,
 }
 
 impl StepEvidence {
@@ -208,6 +238,17 @@ impl StepEvidence {
     /// (all zero where the detector does not integrate): `Ok` for a step on the ground (see
     /// the module).
     pub const fn judge(&self, path: Path) -> Result<(), Rejection> {
+        match self.judge_movement(path) {
+            // A runner's swing needs no stance before it.
+            Ok(()) if !self.settled && self.swing_peak_mradps < RUN_SWING_MRADPS => {
+                Err(Rejection::NoStance)
+            }
+            verdict => verdict,
+        }
+    }
+
+    /// The movement alone, whatever the foot did before it.
+    const fn judge_movement(&self, path: Path) -> Result<(), Rejection> {
         let (horizontal_mm, climb_mm) = (path.horizontal_mm, path.climb_mm);
         if !self.short_enough {
             return Err(Rejection::TooLong);
@@ -312,6 +353,9 @@ pub struct StepLedger {
     last_end: Option<u32>,
     /// Between-time from before a hole, for the next stride.
     pending: Between,
+    /// Where the last movement refused for [`Rejection::NoStance`] ended: the unsettled time
+    /// starts again there (see the module).
+    unsettled_from: Option<u32>,
     /// Where the last step that counted landed: its end, if it ended on the ground (at rest,
     /// or in a runner's stance). The next stride starts from the ground there.
     landed: Option<u32>,
@@ -358,6 +402,7 @@ impl StepLedger {
             next: 0,
             started: false,
             last_end: None,
+            unsettled_from: None,
             landed: None,
             pending: Between {
                 still_ms: 0,
@@ -497,20 +542,32 @@ impl StepLedger {
         }
         // counts → mrad/s: · (10/lsb10) °/s · (π/180) · 1000 = · 174.533/lsb10.
         let peak_mradps = (peak as u64 * 174_533 / (self.lsb10 as u64 * 1000)) as u32;
+        // What the foot did since its last step (or since the last movement refused for
+        // want of a stance, so that a walk out of pedalling loses one stride, not all).
+        let last = self.last_end.unwrap_or(0);
+        let from = match self.unsettled_from {
+            Some(r) if Self::before(last, r) => r,
+            _ => last,
+        };
+        let since = self.split(from, e.start);
         StepEvidence {
             swing_deg: largest / 16,
             swing_peak_mradps: peak_mradps,
             rest_before,
             rest_after,
             short_enough: e.foot_flat.wrapping_sub(e.heel_off) <= self.step_max,
+            settled: since.moving_ms <= UNSETTLED_MS || since.still_ms >= STANCE_MIN_MS,
         }
     }
 
     /// The verdict on the stride `s` whose evidence was `evidence`: where a step that counted
     /// landed on the ground, the next stride starts from it ([`StepEvidence::rest_before`]).
-    pub fn judged(&mut self, s: &Stride, evidence: &StepEvidence, counted: bool) {
+    pub fn judged(&mut self, s: &Stride, evidence: &StepEvidence, verdict: Result<(), Rejection>) {
         let on_ground = evidence.rest_after || evidence.swing_peak_mradps >= RUN_SWING_MRADPS;
-        self.landed = (counted && on_ground).then_some(s.events.end);
+        self.landed = (verdict.is_ok() && on_ground).then_some(s.events.end);
+        if verdict == Err(Rejection::NoStance) {
+            self.unsettled_from = Some(s.events.end);
+        }
     }
 
     /// Rest samples before sample `n`, as far back as the ring reaches (older samples count
@@ -753,15 +810,85 @@ mod tests {
         step(&mut l);
         let first = stride(25, 50, 110, 230);
         let e = l.evidence(&first);
-        l.judged(&first, &e, true);
+        l.judged(&first, &e, Ok(()));
         // The next stride starts at 230 with no rest near it (a run begins): it starts from
         // the ground the last step landed on.
         feed(&mut l, 200, 300, false, pitch(-200.0));
         let next = stride(230, 235, 290, 300);
         assert!(l.evidence(&next).rest_before);
         // Not after a movement that did not count.
-        l.judged(&first, &e, false);
+        l.judged(&first, &e, Err(Rejection::NoSwing));
         assert!(!l.evidence(&next).rest_before);
+    }
+
+    /// 6 s of pedalling at 100 Hz: the foot circles at 200 °/s either way, pausing 0.1 s
+    /// (still) at each dead centre every 0.5 s for 30 ms: 0.36 s at rest in all.
+    fn pedal(l: &mut StepLedger, from: u32, to: u32) {
+        for i in from..to {
+            let phase = (i - from) % 50;
+            let rate = if (i - from) / 50 % 2 == 0 {
+                200.0
+            } else {
+                -200.0
+            };
+            l.process(i, phase < 3, pitch(if phase < 3 { 0.0 } else { rate }));
+        }
+    }
+
+    /// A step-like movement at `at` (0.5 s rest, heel rise, swing, rest), as [`step`] does
+    /// at 0: its stride `(at − 25, at, at + 60, at + 90)`.
+    fn step_at(l: &mut StepLedger, at: u32, rest_before: u32) -> Stride {
+        feed(l, at - rest_before, at, true, pitch(0.0));
+        feed(l, at, at + 20, false, pitch(-200.0));
+        feed(l, at + 20, at + 60, false, pitch(225.0));
+        feed(l, at + 60, at + 150, true, pitch(0.0));
+        stride(at - 25.min(rest_before), at, at + 60, at + 90)
+    }
+
+    #[test]
+    fn a_step_out_of_pedalling_needs_a_stance_first() {
+        // Pedalling never stood for STANCE_MIN_MS in its 6 s; a step-like movement after a
+        // 0.2 s pause is not a step.
+        let mut l = ledger();
+        pedal(&mut l, 0, 600);
+        let s = step_at(&mut l, 620, 20);
+        let e = l.evidence(&s);
+        assert!(e.rest_before && e.rest_after && !e.settled);
+        assert_eq!(e.judge(path(1400, 10)), Err(Rejection::NoStance));
+        // A runner's swing needs no stance.
+        let runner = StepEvidence {
+            swing_peak_mradps: RUN_SWING_MRADPS,
+            ..e
+        };
+        assert_eq!(runner.judge(path(1400, 10)), Ok(()));
+        // The movement refused ends the unsettled time: a walk out of pedalling loses its
+        // first stride, not the walk.
+        l.judged(&s, &e, Err(Rejection::NoStance));
+        let next = step_at(&mut l, 790, 20);
+        let e = l.evidence(&next);
+        assert!(e.settled);
+        assert_eq!(e.judge(path(1400, 10)), Ok(()));
+
+        // Standing after pedalling settles the foot.
+        let mut l = ledger();
+        pedal(&mut l, 0, 600);
+        let s = step_at(&mut l, 700, 100);
+        assert!(l.evidence(&s).settled);
+        // Under five seconds of it too (a wearer shifting on a pedal before stepping off).
+        let mut l = ledger();
+        pedal(&mut l, 0, 450);
+        let s = step_at(&mut l, 470, 20);
+        assert!(l.evidence(&s).settled);
+        // And a step counted since: a walk's own strides never need one.
+        let mut l = ledger();
+        pedal(&mut l, 0, 600);
+        let first = step_at(&mut l, 650, 50);
+        let e = l.evidence(&first);
+        l.judged(&first, &e, Ok(()));
+        let _ = l.between(first.events.start, first.events.end);
+        pedal(&mut l, 800, 1000);
+        let s = step_at(&mut l, 1010, 10);
+        assert!(l.evidence(&s).settled);
     }
 
     #[test]

@@ -242,7 +242,7 @@ fn serial_stride_line_parses_back() {
         &[u32::MAX; 6],
         (
             &gaitclip::detect::step_check::Rejected {
-                by_reason: [u32::MAX; 3],
+                by_reason: [u32::MAX; 4],
                 unchecked: u32::MAX,
             },
             &gaitclip::pipeline::BetweenTotals {

@@ -117,7 +117,7 @@ pub fn status(
     let (rejected, between) = steps;
     write!(
         out,
-        "# status samples={} strides={} distance_mm={} bus_errors={} restarts={} fifo_overflows={} silences={} overruns={} lost_samples={} sleeps={} slept_periods={} estimated={} clipped={},{},{},{},{},{} rejected={},{},{} still_s={} moving_s={}\r\n",
+        "# status samples={} strides={} distance_mm={} bus_errors={} restarts={} fifo_overflows={} silences={} overruns={} lost_samples={} sleeps={} slept_periods={} estimated={} clipped={},{},{},{},{},{} rejected={},{},{},{} still_s={} moving_s={}\r\n",
         samples,
         strides,
         distance_mm,
@@ -139,6 +139,7 @@ pub fn status(
         rejected.by_reason[0],
         rejected.by_reason[1],
         rejected.by_reason[2],
+        rejected.by_reason[3],
         between.still_ms / 1000,
         between.moving_ms / 1000
     )

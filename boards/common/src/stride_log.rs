@@ -222,7 +222,7 @@ impl StrideLog {
     ) {
         let (rejected, between) = steps;
         defmt::println!(
-            "summary strides={=u32} distance_mm={=u64} samples={=u32} overruns={=u32} bus_errors={=u32} restarts={=u32} fifo_overflows={=u32} silences={=u32} lost_samples={=u32} sleeps={=u32} slept_periods={=u32} estimated={=u32} clipped={=u32},{=u32},{=u32},{=u32},{=u32},{=u32} rejected={=u32},{=u32},{=u32} still_s={=u64} moving_s={=u64}",
+            "summary strides={=u32} distance_mm={=u64} samples={=u32} overruns={=u32} bus_errors={=u32} restarts={=u32} fifo_overflows={=u32} silences={=u32} lost_samples={=u32} sleeps={=u32} slept_periods={=u32} estimated={=u32} clipped={=u32},{=u32},{=u32},{=u32},{=u32},{=u32} rejected={=u32},{=u32},{=u32},{=u32} still_s={=u64} moving_s={=u64}",
             self.strides,
             self.distance_mm,
             samples,
@@ -244,6 +244,7 @@ impl StrideLog {
             rejected.by_reason[0],
             rejected.by_reason[1],
             rejected.by_reason[2],
+            rejected.by_reason[3],
             between.still_ms / 1000,
             between.moving_ms / 1000
         );

@@ -301,7 +301,7 @@ pub fn report(dir: &Path) -> Result<String> {
     }
     out.push_str(&t.render());
     out.push_str(&format!(
-        "\nWhere nobody walks: {:.1} false strides per 10 foot-minutes.\n",
+        "\nWhere nobody walks: {:.2} false strides per 10 foot-minutes.\n",
         false_per_10_minutes(&b)
     ));
     out.push_str("\nMovements the step check refused, by the activity labelled at their middle (they count nowhere: no stride, no distance):\n\n");
@@ -345,8 +345,8 @@ pub fn report(dir: &Path) -> Result<String> {
 }
 
 /// Refused movements of every stream, by labelled activity, counted by reason.
-fn refused_by_activity(runs: &[Replayed]) -> BTreeMap<String, [u32; 3]> {
-    let mut out: BTreeMap<String, [u32; 3]> = BTreeMap::new();
+fn refused_by_activity(runs: &[Replayed]) -> BTreeMap<String, [u32; 4]> {
+    let mut out: BTreeMap<String, [u32; 4]> = BTreeMap::new();
     for r in runs {
         let Ok((_, summary)) = &r.result else {
             continue;
