@@ -21,7 +21,8 @@
 //!   [`SWING_MIN_DEG`], turning at least [`SWING_MIN_MRADPS`] at its fastest (a foot drifting on
 //!   a seat turns slower). A shuffle slides the foot a step's length ([`STEP_MIN_MM`]) on the
 //!   level ([`LEVEL_MAX_MM`]) turning it less ([`SHUFFLE_SWING_MIN_DEG`]); a turn on the spot
-//!   turns it about the vertical ([`TURN_STEP_MIN_DEG`]).
+//!   turns it about the vertical ([`TURN_STEP_MIN_DEG`]); a slow high step raises it
+//!   ([`LIFT_STEP_MIN_MM`]) whatever it turns.
 //! - **A running foot has no rest, but a runner's swing.** At a run the foot is never still
 //!   by the rest test; its swing peaks at 6–20 rad/s, faster than pedalling's ankling ever
 //!   turns it (2–4 rad/s; 2.7 the median of `hugadb_daily`'s rides): [`RUN_SWING_MRADPS`]
@@ -77,6 +78,11 @@ pub const LEVEL_MAX_MM: u32 = 100;
 /// least this about the vertical is a turn on the spot, degrees: a U-turn takes two to four
 /// steps of 45–90°; a seated foot pivots by less, and a car turning carries a foot at rest.
 pub const TURN_STEP_MIN_DEG: u32 = 30;
+/// A stride whose swing is small counts if the foot rose this far above where it left the
+/// ground, mm, and came to rest again: a slow high step (over an obstacle, out of a crawl or
+/// a kneel: `pyshoe_vicon`'s foot rises 0.3–0.6 m in such strides, turning 0–20°); a seated
+/// or standing foot shifts centimetres.
+pub const LIFT_STEP_MIN_MM: u32 = 200;
 /// The longest a step's movement lasts (heel-off to foot-flat), ms: 0.3–1 s walking or
 /// running, up to 2.7 s in the slowest shuffles and backward steps of `pyshoe_vicon`; longer is
 /// a movement of something other than a step (the foot frame learns the heading only from
@@ -200,6 +206,8 @@ pub struct Path {
     pub climb_mm: i32,
     /// Heading change, centidegrees.
     pub turn_cdeg: i16,
+    /// The highest the sensor rose above its start, mm.
+    pub lift_mm: u32,
 }
 
 impl Path {
@@ -209,6 +217,7 @@ impl Path {
             horizontal_mm: s.zupt_um / 1000,
             climb_mm: s.climb_mm,
             turn_cdeg: s.turning_angle_cdeg,
+            lift_mm: s.max_sensor_lift_mm as u32,
         }
     }
 }
@@ -273,7 +282,10 @@ impl StepEvidence {
         // A turn on the spot: the foot lifted (the rate above) and turned about the
         // vertical, where a swing is small.
         let turn = path.turn_cdeg.unsigned_abs() as u32 >= TURN_STEP_MIN_DEG * 100;
-        if swing >= SWING_MIN_DEG || shuffle || turn {
+        // A lifted step: the foot raised a step's height and set down again (the rest
+        // after), however little it turned.
+        let lifted = path.lift_mm >= LIFT_STEP_MIN_MM;
+        if swing >= SWING_MIN_DEG || shuffle || turn || lifted {
             Ok(())
         } else {
             Err(Rejection::NoSwing)
@@ -691,6 +703,7 @@ mod tests {
             horizontal_mm,
             climb_mm,
             turn_cdeg: 0,
+            lift_mm: 0,
         }
     }
 
@@ -764,6 +777,22 @@ mod tests {
         };
         assert_eq!(fidget.judge(pivot), Ok(()));
         assert_eq!(drift.judge(pivot), Err(Rejection::NoSwing), "a car turning");
+        // A slow high step: the foot raised a step's height, turning little.
+        let high = Path {
+            lift_mm: LIFT_STEP_MIN_MM,
+            ..path(80, 300)
+        };
+        assert_eq!(fidget.judge(high), Ok(()));
+        let shift = Path {
+            lift_mm: LIFT_STEP_MIN_MM - 1,
+            ..high
+        };
+        assert_eq!(fidget.judge(shift), Err(Rejection::NoSwing));
+        assert_eq!(
+            drift.judge(high),
+            Err(Rejection::NoSwing),
+            "lifted too slowly"
+        );
         // A movement longer than a step.
         let long = StepEvidence {
             short_enough: false,
