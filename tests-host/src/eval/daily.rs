@@ -304,6 +304,7 @@ pub fn report(dir: &Path) -> Result<String> {
         "\nWhere nobody walks: {:.2} false strides per 10 foot-minutes.\n",
         false_per_10_minutes(&b)
     ));
+    out.push_str(&false_strides_table(&runs));
     out.push_str("\nMovements the step check refused, by the activity labelled at their middle (they count nowhere: no stride, no distance):\n\n");
     let mut t = Table::new(
         std::iter::once(Column::from("activity")).chain(
@@ -345,6 +346,71 @@ pub fn report(dir: &Path) -> Result<String> {
 }
 
 /// Refused movements of every stream, by labelled activity, counted by reason.
+/// How close a stride of the other foot must be for the two to be one stepping moment, s:
+/// half a walking stride either side.
+pub const OTHER_FOOT_S: f64 = 1.5;
+
+/// The false strides one by one, with what the stride looked like and whether the other foot
+/// stepped at the same moment (a wearer turning round in an elevator steps with both feet:
+/// steps, whatever the label).
+fn false_strides_table(runs: &[Replayed]) -> String {
+    let mut t = Table::new(vec![
+        Column::from("stream"),
+        Column::from("activity"),
+        Column::right("at, s"),
+        Column::right("swing, °"),
+        Column::right("moved, m"),
+        Column::right("lift, m"),
+        Column::right("turn, °"),
+        Column::right("still / moving before, s"),
+        Column::from("other foot"),
+    ]);
+    let mut n = 0;
+    for r in runs {
+        let Ok((strides, _)) = &r.result else {
+            continue;
+        };
+        let rec = r.stream.name.split('/').next().unwrap_or_default();
+        let other: Vec<f64> = runs
+            .iter()
+            .filter(|o| {
+                o.stream.name != r.stream.name && o.stream.name.starts_with(&format!("{rec}/"))
+            })
+            .filter_map(|o| o.result.as_ref().ok())
+            .flat_map(|(ss, _)| ss.iter().map(movement_middle_s))
+            .collect();
+        for s in strides {
+            let at = movement_middle_s(s);
+            let Some(a) = activity_at(&r.stream.labels, at) else {
+                continue;
+            };
+            if !NOT_WALKING.contains(&a) || near_stepping(&r.stream.labels, s) {
+                continue;
+            }
+            n += 1;
+            let stepped = other.iter().any(|o| (o - at).abs() <= OTHER_FOOT_S);
+            t.row(vec![
+                format!("`{}`", r.stream.name),
+                a.to_string(),
+                format!("{at:.1}"),
+                s.swing_deg.to_string(),
+                format!("{:.2}", s.zupt_m),
+                format!("{:.2}", s.max_sensor_lift_m),
+                format!("{:+.0}", s.turning_angle_deg),
+                format!("{:.1} / {:.1}", s.still_before_s, s.moving_before_s),
+                if stepped { "stepped" } else { "–" }.to_string(),
+            ]);
+        }
+    }
+    if n == 0 {
+        return String::new();
+    }
+    format!(
+        "\nThe false strides one by one (other foot: a stride of the other foot within {OTHER_FOOT_S} s):\n\n{}",
+        t.render()
+    )
+}
+
 fn refused_by_activity(runs: &[Replayed]) -> BTreeMap<String, [u32; 4]> {
     let mut out: BTreeMap<String, [u32; 4]> = BTreeMap::new();
     for r in runs {
