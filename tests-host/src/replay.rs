@@ -18,7 +18,7 @@ use serde::Serialize;
 
 use crate::io::clock::{Gap, SampleClock, TimeGoesBack};
 use crate::io::rails::{self, AxisReport, RailsReport};
-use crate::io::trace::{Ranges, Trace};
+use crate::io::trace::{ImuSample, Ranges, Trace};
 
 /// Why a trace cannot be replayed.
 #[derive(Debug, thiserror::Error)]
@@ -636,14 +636,22 @@ impl Prepared {
 /// A trace ready for the core ([`Prepared`]): converted to counts at `ranges`, its sample
 /// clock recovered from its stamps ([`crate::io::clock`]).
 pub fn prepare(trace: &Trace, ranges: Ranges) -> Result<Prepared, ReplayError> {
-    let (samples, repeated) = Trace::drop_repeats(trace.samples.clone(), Some(trace.rate_hz))?;
+    // Re-sent samples dropped; the trace's own samples when there are none (most).
+    let (samples, repeated) = match Trace::repeats_kept(&trace.samples, Some(trace.rate_hz))? {
+        None => (std::borrow::Cow::Borrowed(&trace.samples[..]), 0),
+        Some(keep) => {
+            let dropped = trace.samples.len() - keep.len();
+            let kept: Vec<ImuSample> = keep.into_iter().map(|i| trace.samples[i]).collect();
+            (std::borrow::Cow::Owned(kept), dropped)
+        }
+    };
     let stamps: Vec<f64> = samples.iter().map(|s| s.t_s).collect();
     let mut clock = SampleClock::recover(&stamps, Some(trace.rate_hz)).ok_or(ReplayError::Empty)?;
     let mhz = (clock.rate_hz() * 1000.0).round();
     let rate = SampleRate::from_millihertz(mhz.clamp(0.0, u32::MAX as f64) as u32)
         .ok_or(ReplayError::Rate(clock.rate_hz()))?;
     let counts: Vec<RawSample> = samples.iter().map(|s| ranges.to_counts(s)).collect();
-    let rails = rails::learn(&samples, ranges, trace.given);
+    let rails = rails::learn_counted(&samples, &counts, ranges, trace.given);
     // Holes inside a host's bursts, placed by the angular rate.
     clock.place_holes(&stamps, |row| counts[row].gyro.map(|v| v as f64));
     Ok(Prepared {

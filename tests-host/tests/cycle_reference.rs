@@ -93,9 +93,11 @@ fn cycle_strides_match_the_f64_twin_within_1_mm() {
             skipped[2],
             skipped[3]
         );
-        // The twin measures the strides that matter: every stride but the first of a walk.
+        // The twin measures the strides that matter: every stride but the first of a walk
+        // (at least 84 % of them: 84.4 % in `pyshoe_vicon` at ±250 °/s, 126 of its 808
+        // valid strides the first after a rest).
         assert!(
-            measured as f64 >= 0.85 * valid as f64,
+            measured as f64 >= 0.84 * valid as f64,
             "{name}: only {measured} of {valid} valid strides measured"
         );
         if ranges.gyro == GyroRange::Dps250 {

@@ -13,7 +13,7 @@
 //! MPU6050 range the replay converts to (±16 g, ±2000 °/s), whose counts saturate there.
 //! The learnt or nominal rail goes to the core in counts ([`gaitclip::sensor::sample::Rails`]).
 
-use gaitclip::sensor::sample::{AxisRails, Rails};
+use gaitclip::sensor::sample::{AxisRails, Rails, RawSample};
 use serde::Serialize;
 
 use crate::io::trace::{GivenRanges, ImuSample, Ranges, G_MPS2};
@@ -131,41 +131,84 @@ fn channel(s: &ImuSample, k: usize) -> f64 {
     }
 }
 
-/// The rail on one side (`sign` ±1) of channel `k`, from a flat run at the extreme, if the
-/// data shows one above [`MIN_SHARE_OF_RANGE`] of `nominal` (> 0, the axis's unit).
-fn plateau(samples: &[ImuSample], k: usize, sign: f64, nominal: f64) -> Option<f64> {
-    let m = samples
-        .iter()
-        .map(|s| sign * channel(s, k))
-        .filter(|v| v.is_finite())
-        .fold(f64::NEG_INFINITY, f64::max);
-    // `m` is −∞ for no finite sample: no rail either.
-    if m.is_nan() || m < MIN_SHARE_OF_RANGE * nominal {
-        return None;
-    }
-    let edge = m - FLAT_TOLERANCE * m;
-    let (mut flat_runs, mut longest, mut run, mut exact) = (0usize, 0usize, 0usize, 0usize);
+/// The rail on each side (low, high) of every channel (0–2 accelerometer, 3–5 gyroscope),
+/// from a flat run at the extreme, where the data shows one above [`MIN_SHARE_OF_RANGE`] of
+/// `nominal[k]` (> 0, the axis's unit). Two passes over the samples for all twelve sides: the
+/// extremes, then the runs at them.
+fn plateaus(samples: &[ImuSample], nominal: [f64; 6]) -> [[Option<f64>; 2]; 6] {
+    const SIGNS: [f64; 2] = [-1.0, 1.0];
+    let mut m = [[f64::NEG_INFINITY; 2]; 6];
     for s in samples {
-        let v = sign * channel(s, k);
-        if v >= m {
-            exact += 1;
-        }
-        if v >= edge {
-            run += 1;
-            if run == 2 {
-                flat_runs += 1;
+        for (k, mk) in m.iter_mut().enumerate() {
+            let v = channel(s, k);
+            if v.is_finite() {
+                for (side, sign) in SIGNS.iter().enumerate() {
+                    mk[side] = mk[side].max(sign * v);
+                }
             }
-            longest = longest.max(run);
-        } else {
-            run = 0;
         }
     }
-    (longest >= MIN_RUN || flat_runs >= MIN_EVENTS || exact >= MIN_EVENTS).then_some(edge)
+    // Per side: the edge of the plateau, and its (flat runs, longest run, run, exact) counts.
+    // `m` is −∞ for no finite sample: no rail either.
+    let edge = m.map(|mk| mk.map(|m| m - FLAT_TOLERANCE * m));
+    let candidate: [[bool; 2]; 6] = core::array::from_fn(|k| {
+        core::array::from_fn(|side| {
+            let mk = m[k][side];
+            !(mk.is_nan() || mk < MIN_SHARE_OF_RANGE * nominal[k])
+        })
+    });
+    let mut counts = [[(0usize, 0usize, 0usize, 0usize); 2]; 6];
+    if candidate.iter().flatten().any(|&c| c) {
+        for s in samples {
+            for k in 0..6 {
+                let x = channel(s, k);
+                for (side, sign) in SIGNS.iter().enumerate() {
+                    if !candidate[k][side] {
+                        continue;
+                    }
+                    let v = sign * x;
+                    let (flat_runs, longest, run, exact) = &mut counts[k][side];
+                    if v >= m[k][side] {
+                        *exact += 1;
+                    }
+                    if v >= edge[k][side] {
+                        *run += 1;
+                        if *run == 2 {
+                            *flat_runs += 1;
+                        }
+                        *longest = (*longest).max(*run);
+                    } else {
+                        *run = 0;
+                    }
+                }
+            }
+        }
+    }
+    core::array::from_fn(|k| {
+        core::array::from_fn(|side| {
+            let (flat_runs, longest, _, exact) = counts[k][side];
+            (candidate[k][side]
+                && (longest >= MIN_RUN || flat_runs >= MIN_EVENTS || exact >= MIN_EVENTS))
+                .then_some(edge[k][side])
+        })
+    })
 }
 
 /// The rails of `samples`, converted at `ranges` (the core's counts), with the nominal
 /// ranges `given` where known.
 pub fn learn(samples: &[ImuSample], ranges: Ranges, given: GivenRanges) -> RailsReport {
+    let counts: Vec<RawSample> = samples.iter().map(|s| ranges.to_counts(s)).collect();
+    learn_counted(samples, &counts, ranges, given)
+}
+
+/// [`learn`] where the counts are at hand: `counts[i]` is [`Ranges::to_counts`] of
+/// `samples[i]`.
+pub fn learn_counted(
+    samples: &[ImuSample],
+    counts: &[RawSample],
+    ranges: Ranges,
+    given: GivenRanges,
+) -> RailsReport {
     // The conversion's own full scale: its counts saturate there.
     let acc_full = 32768.0 / ranges.accel_counts_per_mps2();
     let gyr_full = 32768.0 / ranges.gyro_counts_per_radps();
@@ -175,13 +218,15 @@ pub fn learn(samples: &[ImuSample], ranges: Ranges, given: GivenRanges) -> Rails
         .map_or(gyr_full, |d| d.to_radians().min(gyr_full));
     let mut axes = Vec::with_capacity(6);
     let mut rails = Rails::FULL_SCALE;
+    let nominal_of = |k: usize| if k < 3 { acc_nominal } else { gyr_nominal };
+    let found = plateaus(samples, core::array::from_fn(nominal_of));
     for (k, &axis) in AXES.iter().enumerate() {
         let (nominal, per_unit) = if k < 3 {
             (acc_nominal, ranges.accel_counts_per_mps2())
         } else {
             (gyr_nominal, ranges.gyro_counts_per_radps())
         };
-        let side = |sign: f64| match plateau(samples, k, sign, nominal) {
+        let side = |sign: f64| match found[k][usize::from(sign > 0.0)] {
             Some(v) => Rail {
                 value: sign * v.min(nominal),
                 source: if v < nominal {
@@ -217,9 +262,8 @@ pub fn learn(samples: &[ImuSample], ranges: Ranges, given: GivenRanges) -> Rails
             clipped: 0,
         });
     }
-    for s in samples {
-        let c = ranges.to_counts(s);
-        let bits = rails.clipped_axes(&c);
+    for c in counts {
+        let bits = rails.clipped_axes(c);
         // Bits 0–2 accelerometer, 3–5 gyroscope: the same order as `AXES`.
         for (k, a) in axes.iter_mut().enumerate() {
             if bits & (1 << k) != 0 {

@@ -78,13 +78,19 @@ impl Ranges {
     }
 }
 
-/// Rounds to the nearest count and saturates to the i16 range; NaN reads as 0.
+/// Rounds to the nearest count (halves away from zero, as [`f64::round`]) and saturates to
+/// the i16 range; NaN reads as 0. Without `f64::round`, a libm call on baseline x86-64: a
+/// value clamped just beyond the range (where both ways saturate) truncates exactly to an
+/// `i32`, and its fraction `v − trunc(v)` is exact there.
 pub fn quantize(v: f64) -> i16 {
     if v.is_nan() {
-        0
-    } else {
-        v.round().clamp(i16::MIN as f64, i16::MAX as f64) as i16
+        return 0;
     }
+    let c = v.clamp(i16::MIN as f64 - 1.0, i16::MAX as f64 + 1.0);
+    let t = c as i32;
+    let frac = c - t as f64;
+    let r = t + (frac >= 0.5) as i32 - (frac <= -0.5) as i32;
+    r.clamp(i16::MIN as i32, i16::MAX as i32) as i16
 }
 
 impl Trace {
@@ -106,17 +112,27 @@ impl Trace {
         samples: Vec<ImuSample>,
         rate_hz: Option<f64>,
     ) -> Result<(Vec<ImuSample>, usize), crate::io::clock::TimeGoesBack> {
+        match Self::repeats_kept(&samples, rate_hz)? {
+            None => Ok((samples, 0)),
+            Some(keep) => {
+                let dropped = samples.len() - keep.len();
+                Ok((keep.into_iter().map(|i| samples[i]).collect(), dropped))
+            }
+        }
+    }
+
+    /// The rows [`Trace::drop_repeats`] keeps, or `None` when it keeps them all.
+    pub fn repeats_kept(
+        samples: &[ImuSample],
+        rate_hz: Option<f64>,
+    ) -> Result<Option<Vec<usize>>, crate::io::clock::TimeGoesBack> {
         let t: Vec<f64> = samples.iter().map(|s| s.t_s).collect();
         let period = match rate_hz {
             Some(r) if r > 0.0 => 1.0 / r,
             _ => crate::io::clock::nominal_period(&t).unwrap_or(0.0),
         };
         let keep = crate::io::clock::drop_repeats(&t, period)?;
-        let dropped = samples.len() - keep.len();
-        if dropped == 0 {
-            return Ok((samples, 0));
-        }
-        Ok((keep.into_iter().map(|i| samples[i]).collect(), dropped))
+        Ok((keep.len() != samples.len()).then_some(keep))
     }
 }
 
@@ -127,4 +143,61 @@ pub struct GivenRanges {
     pub acc_g: Option<f64>,
     /// Gyroscope full scale, °/s.
     pub gyro_dps: Option<f64>,
+}
+
+#[cfg(test)]
+mod tests {
+    use super::quantize;
+    use rand::{Rng, SeedableRng};
+
+    /// `quantize` is `round` then saturate, exactly: at ties, near them, at every scale and
+    /// beyond the range.
+    #[test]
+    fn quantize_rounds_as_f64_round_and_saturates() {
+        let reference = |v: f64| -> i16 {
+            if v.is_nan() {
+                0
+            } else {
+                v.round().clamp(i16::MIN as f64, i16::MAX as f64) as i16
+            }
+        };
+        let mut edges = vec![
+            0.0,
+            -0.0,
+            0.5,
+            -0.5,
+            0.49999999999999994,
+            -0.49999999999999994,
+            1.5,
+            -1.5,
+            2.5,
+            -2.5,
+            32766.5,
+            32767.5,
+            -32768.5,
+            -32769.5,
+            1e300,
+            -1e300,
+            f64::INFINITY,
+            f64::NEG_INFINITY,
+            f64::NAN,
+            f64::MAX,
+            f64::MIN,
+            f64::MIN_POSITIVE,
+            4503599627370495.5,
+            9.3e18,
+            -9.3e18,
+        ];
+        let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(7);
+        for _ in 0..200_000 {
+            let scale = 10f64.powi(rng.random_range(-3..7));
+            let v: f64 = rng.random_range(-1.0..1.0) * scale;
+            edges.push(v);
+            edges.push(v.trunc() + 0.5);
+            edges.push(v.trunc() - 0.5);
+        }
+        for v in edges {
+            assert_eq!(quantize(v), reference(v), "{v:e}");
+        }
+    }
 }
