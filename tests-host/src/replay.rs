@@ -128,7 +128,8 @@ pub struct RejectedReport {
     pub end_s: f64,
     /// Its movement (the detector's heel-off to foot-flat), s.
     pub movement_s: (f64, f64),
-    /// Why: `no_rest` or `no_swing`.
+    /// Why: [`gaitclip::detect::step_check::Rejection::name`] (`no_rest`, `no_swing`,
+    /// `too_long`, `no_stance`).
     pub reason: &'static str,
     /// The foot's largest rotation about its pitch axis in it, degrees.
     pub swing_deg: u16,
