@@ -49,6 +49,14 @@ pub const STAIRS_MIN_CLIMB_MM: u32 = 150;
 /// and a steep street 0.2), so that a long stride up a hill is not a flight of stairs.
 pub const STAIRS_MIN_SLOPE_PERMILLE: u32 = 300;
 
+/// A stride on stairs spans at most this far, mm: two treads step-over-step, four taken two
+/// at a time, and treads are 0.25–0.35 m. Longer, its climb is not a staircase's but an
+/// integration's error (sprint strides at both rails "climb" 0.8–1.4 m over 1.6–2.4 m on the
+/// level `esangeni_course`), and its class is the duty factor's.
+pub const STAIRS_MAX_LEVEL_MM: u32 = 1400;
+/// …and climbs at most this, mm: four risers of at most 0.2 m.
+pub const STAIRS_MAX_CLIMB_MM: u32 = 800;
+
 /// Flags under which the stride's times do not describe one gait cycle: a stride from or
 /// into a rest spans the standing, a gap hides events.
 const NOT_A_CYCLE: u16 = StrideFlags::FROM_REST | StrideFlags::TO_REST | StrideFlags::GAP;
@@ -149,8 +157,10 @@ impl GaitParameters {
 }
 
 /// Stairs up or down, where the stride climbed a stair's height at a stair's slope
-/// ([`STAIRS_MIN_CLIMB_MM`], [`STAIRS_MIN_SLOPE_PERMILLE`]); `None` on the level, on a slope a
-/// walker walks, and for a stride without a ZUPT trajectory (Lu's steps, a gap).
+/// ([`STAIRS_MIN_CLIMB_MM`], [`STAIRS_MIN_SLOPE_PERMILLE`]) over no more than a flight's
+/// stride allows ([`STAIRS_MAX_LEVEL_MM`], [`STAIRS_MAX_CLIMB_MM`]); `None` on the level, on
+/// a slope a walker walks, for a climb no staircase gives, and for a stride without a ZUPT
+/// trajectory (Lu's steps, a gap).
 pub const fn stairs(stride: &Stride) -> Option<Gait> {
     if stride.zupt_um == 0 || stride.flags.0 & StrideFlags::GAP != 0 {
         return None;
@@ -159,6 +169,8 @@ pub const fn stairs(stride: &Stride) -> Option<Gait> {
     let level_mm = stride.zupt_um as u64 / 1000;
     if climb < STAIRS_MIN_CLIMB_MM as u64
         || climb * 1000 < level_mm * STAIRS_MIN_SLOPE_PERMILLE as u64
+        || climb > STAIRS_MAX_CLIMB_MM as u64
+        || level_mm > STAIRS_MAX_LEVEL_MM as u64
     {
         return None;
     }
@@ -196,6 +208,30 @@ mod tests {
             length_mm: mm,
             ..Stride::default()
         }
+    }
+
+    #[test]
+    fn stairs_are_a_stair_climb_over_a_stair_stride() {
+        let path = |level_mm: u32, climb_mm: i32| Stride {
+            zupt_um: level_mm * 1000,
+            climb_mm,
+            ..stride(0, 20, 80, 100, level_mm)
+        };
+        // Step-over-step: two risers over two treads, up and down.
+        assert_eq!(stairs(&path(600, 340)), Some(Gait::StairsUp));
+        assert_eq!(stairs(&path(600, -340)), Some(Gait::StairsDown));
+        // Two at a time: four of each.
+        assert_eq!(stairs(&path(1200, 700)), Some(Gait::StairsUp));
+        // The level, a ramp's stride, a street's.
+        assert_eq!(stairs(&path(1400, 20)), None);
+        assert_eq!(stairs(&path(1400, 116)), None);
+        assert_eq!(stairs(&path(1400, 280)), None);
+        // Beyond any flight's stride: a sprint stride's integration at the rails.
+        assert_eq!(stairs(&path(2100, 950)), None);
+        assert_eq!(stairs(&path(STAIRS_MAX_LEVEL_MM + 1, 600)), None);
+        assert_eq!(stairs(&path(600, STAIRS_MAX_CLIMB_MM as i32 + 1)), None);
+        // Without a trajectory.
+        assert_eq!(stairs(&path(0, 340)), None);
     }
 
     #[test]
