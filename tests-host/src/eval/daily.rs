@@ -207,6 +207,13 @@ fn near_stepping(labels: &[Segment], s: &StrideReport) -> bool {
     })
 }
 
+/// The activity stride `s` is a false one under (nobody walks there, and no stepping
+/// segment lies within [`BOUNDARY_S`]), if it is one.
+fn false_under<'a>(labels: &'a [Segment], s: &StrideReport) -> Option<&'a str> {
+    let a = activity_at(labels, movement_middle_s(s))?;
+    (NOT_WALKING.contains(&a) && !near_stepping(labels, s)).then_some(a)
+}
+
 /// Tallies `runs` by activity.
 pub fn by_activity(runs: &[Replayed]) -> ByActivity {
     let mut b = ByActivity::default();
@@ -225,9 +232,9 @@ pub fn by_activity(runs: &[Replayed]) -> ByActivity {
         for s in strides {
             if let Some(a) = activity_at(&r.stream.labels, movement_middle_s(s)) {
                 *b.strides.entry(a.to_string()).or_default() += 1;
-                if NOT_WALKING.contains(&a) && !near_stepping(&r.stream.labels, s) {
-                    *b.false_strides.entry(a.to_string()).or_default() += 1;
-                }
+            }
+            if let Some(a) = false_under(&r.stream.labels, s) {
+                *b.false_strides.entry(a.to_string()).or_default() += 1;
             }
         }
     }
@@ -345,7 +352,6 @@ pub fn report(dir: &Path) -> Result<String> {
     Ok(out)
 }
 
-/// Refused movements of every stream, by labelled activity, counted by reason.
 /// How close a stride of the other foot must be for the two to be one stepping moment, s:
 /// half a walking stride either side.
 pub const OTHER_FOOT_S: f64 = 1.5;
@@ -380,13 +386,10 @@ fn false_strides_table(runs: &[Replayed]) -> String {
             .flat_map(|(ss, _)| ss.iter().map(movement_middle_s))
             .collect();
         for s in strides {
-            let at = movement_middle_s(s);
-            let Some(a) = activity_at(&r.stream.labels, at) else {
+            let Some(a) = false_under(&r.stream.labels, s) else {
                 continue;
             };
-            if !NOT_WALKING.contains(&a) || near_stepping(&r.stream.labels, s) {
-                continue;
-            }
+            let at = movement_middle_s(s);
             n += 1;
             let stepped = other.iter().any(|o| (o - at).abs() <= OTHER_FOOT_S);
             t.row(vec![
@@ -411,6 +414,7 @@ fn false_strides_table(runs: &[Replayed]) -> String {
     )
 }
 
+/// Refused movements of every stream, by labelled activity, counted by reason.
 fn refused_by_activity(runs: &[Replayed]) -> BTreeMap<String, [u32; 4]> {
     let mut out: BTreeMap<String, [u32; 4]> = BTreeMap::new();
     for r in runs {
