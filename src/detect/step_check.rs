@@ -26,7 +26,10 @@
 //! - **A running foot has no rest, but a runner's swing.** At a run the foot is never still
 //!   by the rest test; its swing peaks at 6–20 rad/s, faster than pedalling's ankling ever
 //!   turns it (2–4 rad/s; 2.7 the median of `hugadb_daily`'s rides): [`RUN_SWING_MRADPS`]
-//!   stands for the rest.
+//!   stands for the rest. A stride into a run from standing, or out of one into standing,
+//!   has a rest on one side only and a swing not yet (or no longer) a runner's: it counts
+//!   where its swing is faster than pedalling turns a foot ([`RUN_START_SWING_MRADPS`]) and
+//!   it lands on the level a step's length away, which a pedal's circle does not.
 //! - **A step takes the time of a step.** A movement longer than [`STEP_MAX_MS`] is not one.
 //! - **A step starts from standing.** A foot on a pedal pauses now and then, still by the
 //!   rest test for a moment, and then moves as a shuffle or a stair step would (on
@@ -66,6 +69,14 @@ pub const SWING_MIN_MRADPS: u32 = crate::detect::gyro_events::SWING_MIN_MRADPS;
 /// a rest (see the module). A walking swing peaks at 4–10 rad/s, a running one at 8–20;
 /// pedalling's ankling at 2–4 rad/s (2.8 rad/s the median on `hugadb_daily`'s rides).
 pub const RUN_SWING_MRADPS: u32 = 4500;
+/// A stride with a rest on one side only (the first stride of a run, out of standing, or the
+/// last, into it) counts if its swing turns the foot at least this fast, mrad/s, and it
+/// lands on the level ([`LEVEL_MAX_MM`]) at least a step's length away ([`STEP_MIN_MM`]):
+/// `pyshoe_vicon`'s first strides out of standing into a run peak at 3.8–4.3 rad/s, walking
+/// swings at 4–10; pedalling turns the foot at 2–4 rad/s, and a pedal's movement between a
+/// pause and the crank's turn ends above or below where it began (a crank's circle), or
+/// carries the foot less than a step.
+pub const RUN_START_SWING_MRADPS: u32 = 3500;
 /// A stride whose swing is smaller counts if its foot moved this far, mm, on the level (a
 /// shuffle slides the foot a step's length turning it by 10–25°; a shift of weight moves it
 /// centimetres).
@@ -264,9 +275,18 @@ impl StepEvidence {
             return Err(Rejection::TooLong);
         }
         let swing = self.swing_deg;
+        // The foot landed on the level a step's length from where it left.
+        let level_step = horizontal_mm >= STEP_MIN_MM && climb_mm.unsigned_abs() <= LEVEL_MAX_MM;
         if !(self.rest_before && self.rest_after) {
-            // No rest either side: only a runner's swing is a step.
-            return if swing >= SWING_MIN_DEG && self.swing_peak_mradps >= RUN_SWING_MRADPS {
+            // No rest either side: only a runner's swing is a step; a rest on one side and a
+            // swing faster than pedalling onto the level a step away is a run's first or
+            // last stride.
+            let runner = swing >= SWING_MIN_DEG && self.swing_peak_mradps >= RUN_SWING_MRADPS;
+            let run_start = (self.rest_before || self.rest_after)
+                && swing >= SWING_MIN_DEG
+                && self.swing_peak_mradps >= RUN_START_SWING_MRADPS
+                && level_step;
+            return if runner || run_start {
                 Ok(())
             } else {
                 Err(Rejection::NoRest)
@@ -277,9 +297,7 @@ impl StepEvidence {
             return Err(Rejection::NoSwing);
         }
         // A shuffle: the foot slid a step's length and stayed on the level.
-        let shuffle = swing >= SHUFFLE_SWING_MIN_DEG
-            && horizontal_mm >= STEP_MIN_MM
-            && climb_mm.unsigned_abs() <= LEVEL_MAX_MM;
+        let shuffle = swing >= SHUFFLE_SWING_MIN_DEG && level_step;
         // A turn on the spot: the foot lifted (the rate above) and turned about the
         // vertical, where a swing is small.
         let turn = path.turn_cdeg.unsigned_abs() as u32 >= TURN_STEP_MIN_DEG * 100;
@@ -739,10 +757,53 @@ mod tests {
         assert_eq!(e.judge(path(1400, 10)), Ok(()));
         // The same rotation without the rests: not a step, unless it is a runner's swing.
         let mut pedalling = e;
-        pedalling.rest_before = false;
+        (pedalling.rest_before, pedalling.rest_after) = (false, false);
         assert_eq!(pedalling.judge(path(1400, 10)), Err(Rejection::NoRest));
         pedalling.swing_peak_mradps = RUN_SWING_MRADPS;
         assert_eq!(pedalling.judge(path(1400, 10)), Ok(()));
+        // A run's first stride: a rest before, none after, a swing faster than pedalling
+        // onto the level a step away; not a pedal's arc, nor a pedal's slower turn.
+        let run_start = StepEvidence {
+            rest_after: false,
+            swing_peak_mradps: RUN_START_SWING_MRADPS,
+            ..e
+        };
+        assert_eq!(run_start.judge(path(STEP_MIN_MM, 40)), Ok(()));
+        let run_end = StepEvidence {
+            rest_before: false,
+            rest_after: true,
+            ..run_start
+        };
+        assert_eq!(run_end.judge(path(900, -40)), Ok(()));
+        assert_eq!(
+            run_start.judge(path(900, LEVEL_MAX_MM as i32 + 1)),
+            Err(Rejection::NoRest),
+            "up a crank's arc"
+        );
+        assert_eq!(
+            run_start.judge(path(STEP_MIN_MM - 1, 0)),
+            Err(Rejection::NoRest),
+            "less than a step"
+        );
+        let slow = StepEvidence {
+            swing_peak_mradps: RUN_START_SWING_MRADPS - 1,
+            ..run_start
+        };
+        assert_eq!(
+            slow.judge(path(900, 0)),
+            Err(Rejection::NoRest),
+            "pedalling"
+        );
+        let small = StepEvidence {
+            swing_deg: SWING_MIN_DEG - 1,
+            ..run_start
+        };
+        assert_eq!(small.judge(path(900, 0)), Err(Rejection::NoRest));
+        let neither = StepEvidence {
+            rest_before: false,
+            ..run_start
+        };
+        assert_eq!(neither.judge(path(900, 0)), Err(Rejection::NoRest));
         // A few degrees between rests: a shift of weight.
         let fidget = StepEvidence {
             swing_deg: 4,
