@@ -16,6 +16,15 @@
 //! how many samples clipped and where in the
 //! stride (push-off: heel-off to toe-off; swing; heel strike: heel-strike to the stance
 //! instant that ends the stride).
+//!
+//! **A sprint's rails, on running strides that did not reach them.** At a sprint both
+//! sensors of a foot pod sit at their rails at once (±16 g at touch-down and push-off,
+//! ±2 000 °/s around toe-off); what that takes from a stride cannot be measured on the sprint
+//! itself, which has no unclipped self. The running strides of the 800 Hz recordings
+//! (`esangeni_run`, and `esangeni_course`'s jog and run) peak at 10–15 g and 1 000–1 400 °/s:
+//! converted at ±8 g, at ±1 000 °/s and at both, they meet their rails where a sprint meets
+//! its own, and each is compared with itself as recorded ([`SPRINT_CLIPPINGS`], strides
+//! clipped by the conversion and not as recorded), length and climb.
 
 use anyhow::Result;
 use gaitclip::record::stride::{Stride, StrideFlags};
@@ -67,6 +76,48 @@ pub const CLIPPINGS: [Clipping; 3] = [
     },
 ];
 
+/// A sprint's two rails met at once, on the 800 Hz running strides (see the module): the
+/// accelerometer at the MPU6050's ±8 g, the gyro at its ±1 000 °/s, and both.
+pub const SPRINT_CLIPPINGS: [Clipping; 3] = [
+    Clipping {
+        label: "accelerometer at ±8 g",
+        ranges: Ranges {
+            accel: AccelRange::G8,
+            gyro: GyroRange::Dps2000,
+        },
+        clamp_g: None,
+    },
+    Clipping {
+        label: "gyro at ±1 000 °/s",
+        ranges: Ranges {
+            accel: AccelRange::G16,
+            gyro: GyroRange::Dps1000,
+        },
+        clamp_g: None,
+    },
+    Clipping {
+        label: "both (±8 g, ±1 000 °/s)",
+        ranges: Ranges {
+            accel: AccelRange::G8,
+            gyro: GyroRange::Dps1000,
+        },
+        clamp_g: None,
+    },
+];
+
+/// The recordings [`SPRINT_CLIPPINGS`] run on.
+pub const SPRINT_DATASETS: [&str; 2] = ["esangeni_run", "esangeni_course"];
+
+/// Which clipped strides a sweep compares.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Clipped {
+    /// Those with the accelerometer at a rail (what [`gaitclip::detect::clipping`] puts
+    /// back).
+    Accel,
+    /// Those with either sensor at a rail that were not clipped as recorded.
+    Newly,
+}
+
 /// Where in its stride a clipped sample lies.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Position {
@@ -94,6 +145,8 @@ pub struct ClippedStride {
     /// What the estimate from the strides before it would have said, minus the unclipped
     /// stride's reported length, m.
     pub estimate_m: Option<f64>,
+    /// Its climb with the loss put back, and the unclipped stride's, m.
+    pub climb_m: (f64, f64),
 }
 
 /// The clipped strides of one dataset under one clipping, and how many strides there were.
@@ -150,8 +203,17 @@ fn position(s: &Stride, at: &[u32]) -> Position {
     ][k]
 }
 
-/// One dataset under one clipping.
+/// One dataset under one clipping: the strides with the accelerometer at a rail.
 pub fn sweep(dataset: &datasets::Dataset, clipping: &Clipping) -> Result<SweepResult> {
+    sweep_of(dataset, clipping, Clipped::Accel)
+}
+
+/// One dataset under one clipping, the strides `which` says.
+pub fn sweep_of(
+    dataset: &datasets::Dataset,
+    clipping: &Clipping,
+    which: Clipped,
+) -> Result<SweepResult> {
     let mut out = SweepResult::default();
     for trial in &dataset.trials {
         let t = csv_trace::read(&trial.csv, Some(dataset.rate_hz))?;
@@ -173,7 +235,10 @@ pub fn sweep(dataset: &datasets::Dataset, clipping: &Clipping) -> Result<SweepRe
             .counts
             .iter()
             .enumerate()
-            .filter(|(_, s)| rails.accel_clipped(s))
+            .filter(|(_, s)| match which {
+                Clipped::Accel => rails.accel_clipped(s),
+                Clipped::Newly => rails.accel_clipped(s) || rails.gyro_clipped(s),
+            })
             .map(|(i, _)| p.clock.number_of_row(i))
             .collect();
         out.clipped_samples += clipped_at.len();
@@ -181,7 +246,14 @@ pub fn sweep(dataset: &datasets::Dataset, clipping: &Clipping) -> Result<SweepRe
         for (s, l) in restored.iter().zip(&left) {
             let est = estimator.estimate_mm();
             estimator.process(&mut s.clone());
-            if !s.flags.has(StrideFlags::ACCEL_CLIPPED) || s.flags.has(StrideFlags::GAP) {
+            let clipped = |x: &Stride, f: u16| x.flags.has(f);
+            let counted = match which {
+                Clipped::Accel => clipped(s, StrideFlags::ACCEL_CLIPPED),
+                Clipped::Newly => {
+                    clipped(s, StrideFlags::ACCEL_CLIPPED | StrideFlags::GYRO_CLIPPED)
+                }
+            };
+            if !counted || s.flags.has(StrideFlags::GAP) {
                 out.matched += 1;
                 continue;
             }
@@ -189,6 +261,13 @@ pub fn sweep(dataset: &datasets::Dataset, clipping: &Clipping) -> Result<SweepRe
                 out.moved += 1;
                 continue;
             };
+            // Clipped as recorded: no unclipped self to compare with.
+            if which == Clipped::Newly
+                && clipped(r, StrideFlags::ACCEL_CLIPPED | StrideFlags::GYRO_CLIPPED)
+            {
+                out.matched += 1;
+                continue;
+            }
             out.matched += 1;
             let at: Vec<u32> = clipped_at
                 .iter()
@@ -202,6 +281,7 @@ pub fn sweep(dataset: &datasets::Dataset, clipping: &Clipping) -> Result<SweepRe
                 left_m: m(l) - m(r),
                 restored_m: m(s) - m(r),
                 estimate_m: est.map(|e| (e as f64 - r.length_mm as f64) / 1000.0),
+                climb_m: (s.climb_mm as f64 / 1000.0, r.climb_mm as f64 / 1000.0),
             });
         }
     }
@@ -278,8 +358,68 @@ pub fn report(root: &std::path::Path) -> Result<String> {
     }
     Ok(format!(
         "Clipped strides against their unclipped selves (ZUPT length; RMSE / bias cm (strides)):\n\n{}\n\
-         The loss put back, by clipped samples in the stride and where most of them lie (RMSE / bias cm (strides)):\n\n{}",
+         The loss put back, by clipped samples in the stride and where most of them lie (RMSE / bias cm (strides)):\n\n{}\n\
+         A sprint's rails on the 800 Hz running strides that did not reach them (strides the conversion clipped, against themselves as recorded; ZUPT length RMSE / bias cm (strides); |climb| m):\n\n{}",
         summary.render(),
-        by.render()
+        by.render(),
+        sprint_table(root)?.render()
     ))
+}
+
+/// The table of [`SPRINT_CLIPPINGS`] on [`SPRINT_DATASETS`].
+pub fn sprint_table(root: &std::path::Path) -> Result<Table> {
+    let mut t = Table::new([
+        "clipping",
+        "dataset",
+        "clipped strides (of strides)",
+        "instants moved",
+        "accelerometer's loss left in",
+        "loss put back",
+        "estimate instead",
+        "|climb| median / p95: clipped (as recorded)",
+        "climb over 0.3 m: clipped (as recorded)",
+    ]);
+    for c in &SPRINT_CLIPPINGS {
+        for name in SPRINT_DATASETS {
+            let d = datasets::load(&root.join(name))?;
+            let r = sweep_of(&d, c, Clipped::Newly)?;
+            let pick = |f: &dyn Fn(&ClippedStride) -> Option<f64>| -> Vec<f64> {
+                r.strides.iter().filter_map(f).collect()
+            };
+            let climb = |k: usize| -> Vec<f64> {
+                let mut v: Vec<f64> = r
+                    .strides
+                    .iter()
+                    .map(|s| [s.climb_m.0, s.climb_m.1][k].abs())
+                    .collect();
+                v.sort_by(f64::total_cmp);
+                v
+            };
+            let q = |v: &[f64], p: f64| {
+                v.get(((v.len().max(1) - 1) as f64 * p).round() as usize)
+                    .copied()
+                    .unwrap_or(0.0)
+            };
+            let (clipped, recorded) = (climb(0), climb(1));
+            let over = |v: &[f64]| v.iter().filter(|&&x| x > 0.3).count();
+            t.row([
+                c.label.to_string(),
+                d.name.clone(),
+                format!("{} ({})", r.strides.len(), r.matched + r.moved),
+                r.moved.to_string(),
+                cm_cell(&pick(&|s| Some(s.left_m))),
+                cm_cell(&pick(&|s| Some(s.restored_m))),
+                cm_cell(&pick(&|s| s.estimate_m)),
+                format!(
+                    "{:.2} / {:.2} ({:.2} / {:.2})",
+                    q(&clipped, 0.5),
+                    q(&clipped, 0.95),
+                    q(&recorded, 0.5),
+                    q(&recorded, 0.95)
+                ),
+                format!("{} ({})", over(&clipped), over(&recorded)),
+            ]);
+        }
+    }
+    Ok(t)
 }
