@@ -43,6 +43,11 @@ pub struct Instant {
     pub stance_pct: f64,
     /// Called running.
     pub running: bool,
+    /// Our stride's climb, m.
+    pub climb_m: f64,
+    /// The Vicon marker's height change over the stride (its end instant's row less its
+    /// start's), m: the floor is level, so about zero.
+    pub vicon_climb_m: f64,
 }
 
 /// The instants of every clean matched stride of `pyshoe_vicon`.
@@ -81,6 +86,11 @@ pub fn instants(root: &std::path::Path) -> Result<Vec<Instant>> {
             let marker = ((b[0] - a[0]).powi(2) + (b[1] - a[1]).powi(2) + (b[2] - a[2]).powi(2))
                 .sqrt()
                 / (4.0 * dt);
+            let end_row = p.clock.row_of_number(s.events.end) as usize;
+            let vicon_climb_m = match pos.get(end_row) {
+                Some(e) if !e[2].is_nan() && !pos[row][2].is_nan() => e[2] - pos[row][2],
+                _ => f64::NAN,
+            };
             let g = p.counts[row].gyro;
             let omega = (g.iter().map(|&v| (v as f64).powi(2)).sum::<f64>()).sqrt() / per_radps;
             let vicon_stance_ms = stance.get(row).copied().unwrap_or(false).then(|| {
@@ -96,6 +106,8 @@ pub fn instants(root: &std::path::Path) -> Result<Vec<Instant>> {
                 vicon_stance_ms,
                 stance_pct: s.gait.stance_permille as f64 / 10.0,
                 running: s.gait.gait == Gait::Running,
+                climb_m: s.climb_mm as f64 / 1000.0,
+                vicon_climb_m,
             });
         }
     }
@@ -116,6 +128,7 @@ pub fn report(root: &std::path::Path) -> Result<String> {
         "that stance (median)",
         "our stance % (median)",
         "called running",
+        "|climb| median / p95 (Vicon's)",
     ]);
     for (lo, hi) in SPEED_BINS {
         let b: Vec<&Instant> = all
@@ -154,10 +167,81 @@ pub fn report(root: &std::path::Path) -> Result<String> {
                 b.iter().filter(|x| x.running).count(),
                 100.0 * b.iter().filter(|x| x.running).count() as f64 / b.len() as f64
             ),
+            climb_cell(&b),
+        ]);
+    }
+    // A climb on the level floor is an error of the integration: what it says of the length.
+    let mut c = Table::new([
+        "our |climb|",
+        "strides",
+        "ZUPT RMSE / bias cm",
+        "median |error| cm",
+        "Vicon's |climb| median / max",
+    ]);
+    for (lo, hi) in CLIMB_BINS {
+        let b: Vec<&Instant> = all
+            .iter()
+            .filter(|x| x.climb_m.abs() >= lo && x.climb_m.abs() < hi)
+            .collect();
+        if b.is_empty() {
+            continue;
+        }
+        let vicon: Vec<f64> = b
+            .iter()
+            .map(|x| x.vicon_climb_m.abs())
+            .filter(|v| v.is_finite())
+            .collect();
+        let errors: Vec<f64> = b.iter().map(|x| x.zupt_error_m).collect();
+        c.row([
+            if hi.is_infinite() {
+                format!("> {lo} m")
+            } else {
+                format!("{lo}–{hi} m")
+            },
+            b.len().to_string(),
+            cm_cell(&errors),
+            format!(
+                "{:.1}",
+                100.0 * median(&errors.iter().map(|e| e.abs()).collect::<Vec<_>>())
+            ),
+            format!(
+                "{:.3} / {:.3} m",
+                median(&vicon),
+                vicon.iter().copied().fold(0.0, f64::max)
+            ),
         ]);
     }
     Ok(format!(
-        "`pyshoe_vicon`, clean matched strides by the Vicon stride's speed; the instant is the stance instant our stride starts at:\n\n{}",
-        t.render()
+        "`pyshoe_vicon`, clean matched strides by the Vicon stride's speed; the instant is the stance instant our stride starts at:\n\n{}\n\
+         The same strides by the climb our integration gives them (the Vicon marker's own climb beside it), against the Vicon's length:\n\n{}",
+        t.render(),
+        c.render()
     ))
+}
+
+/// Bins of |climb| for the second table, m.
+pub const CLIMB_BINS: [(f64, f64); 4] = [(0.0, 0.1), (0.1, 0.2), (0.2, 0.3), (0.3, f64::INFINITY)];
+
+/// `median / p95 (Vicon's median / p95)` of |climb|, m.
+fn climb_cell(b: &[&Instant]) -> String {
+    let mut ours: Vec<f64> = b.iter().map(|x| x.climb_m.abs()).collect();
+    let mut vicon: Vec<f64> = b
+        .iter()
+        .map(|x| x.vicon_climb_m.abs())
+        .filter(|v| v.is_finite())
+        .collect();
+    ours.sort_by(f64::total_cmp);
+    vicon.sort_by(f64::total_cmp);
+    let q = |v: &[f64], p: f64| {
+        v.get(((v.len().max(1) - 1) as f64 * p).round() as usize)
+            .copied()
+            .unwrap_or(f64::NAN)
+    };
+    format!(
+        "{:.2} / {:.2} m ({:.2} / {:.2})",
+        q(&ours, 0.5),
+        q(&ours, 0.95),
+        q(&vicon, 0.5),
+        q(&vicon, 0.95)
+    )
 }
