@@ -115,6 +115,7 @@ fn run<'py>(
         ("gait_velocity_m_s", |s| s.gait_velocity_m_s),
         ("max_sensor_lift_m", |s| s.max_sensor_lift_m),
         ("turning_angle_deg", |s| s.turning_angle_deg),
+        ("travel_deg", |s| s.travel_deg),
         ("still_before_s", |s| s.still_before_s),
         ("moving_before_s", |s| s.moving_before_s),
     ] {

@@ -114,6 +114,11 @@ pub struct Displacement {
     /// `max_sensor_lift`), over the kept trajectory points ([`LIFT_POINTS`]) and the end,
     /// de-drifted as the displacement is; 0 if it never rose.
     pub max_lift_um: u32,
+    /// Direction of the horizontal displacement in the level frame of the start,
+    /// centidegrees counter-clockwise from its x axis, in (−18 000, 18 000] (0 for none):
+    /// [`crate::fixed::atan2_cdeg`] of the rounded µm components, within 1 centidegree of
+    /// their exact angle.
+    pub travel_cdeg: i16,
 }
 
 impl Displacement {
@@ -126,6 +131,7 @@ impl Displacement {
             ((d.vertical_um + 500).div_euclid(1000)).clamp(i32::MIN as i64, i32::MAX as i64) as i32;
         s.max_sensor_lift_mm = ((d.max_lift_um as u64 + 500) / 1000).min(u16::MAX as u64) as u16;
         s.turning_angle_cdeg = turning_angle_cdeg;
+        s.travel_cdeg = d.travel_cdeg;
     }
 }
 
@@ -577,7 +583,13 @@ impl ZuptIntegrator {
         // Horizontally ±2³¹ µm (2 km, far beyond any stride): the sum of squares then fits
         // a u64 (≤ 2⁶³) whatever a hostile input integrated to.
         let horizontal = |v: i128| v.clamp(-(1 << 31), 1 << 31).unsigned_abs() as u64;
-        let (x, y) = (horizontal(um(0)), horizontal(um(1)));
+        let (dx, dy) = (um(0), um(1));
+        let (x, y) = (horizontal(dx), horizontal(dy));
+        // Within ±2³¹ µm as above: far inside atan2_cdeg's range, and its result inside i16.
+        let travel = atan2_cdeg(
+            dx.clamp(-(1 << 31), 1 << 31) as i64,
+            dy.clamp(-(1 << 31), 1 << 31) as i64,
+        );
         // The highest doubled height, de-drifted: a velocity error growing linearly to v_N
         // leaves v_N·c²/N on the doubled position at sample c; compared as ·N.
         let drift_z = drift[2] as i128;
@@ -597,6 +609,7 @@ impl ZuptIntegrator {
             horizontal_um: isqrt_u64(x * x + y * y),
             vertical_um: clamp(um(2)),
             max_lift_um: top_um.clamp(0, u32::MAX as i128) as u32,
+            travel_cdeg: travel.clamp(-18_000, 18_000) as i16,
         }
     }
 }

@@ -159,6 +159,14 @@ pub struct Stride {
     /// positive (gaitmap's `turning_angle`, [`crate::detect::zupt::ZuptIntegrator::heading_change_cdeg`]);
     /// 0 without a ZUPT trajectory.
     pub turning_angle_cdeg: i16,
+    /// Which way the foot travelled over the stride, centidegrees counter-clockwise seen from
+    /// above, in (−18 000, 18 000]: the direction of the horizontal ZUPT displacement in the
+    /// level frame of the stride's start, whose x axis is the sensor's x axis laid level
+    /// ([`crate::fixed::QuatQ30::level_from_up`]). The foot stands the same way on the
+    /// sensor at every stance, so this is the direction of travel against the foot, offset
+    /// by how the clip is mounted: a backward stride reads 180° from a forward one, a
+    /// sideways one 90° (not a compass heading). 0 without a ZUPT trajectory.
+    pub travel_cdeg: i16,
     /// Timing, velocity, cadence, walking or running: the pipeline's last stage
     /// ([`crate::gait`]), once the length is set.
     pub gait: GaitParameters,

@@ -318,6 +318,10 @@ pub struct StrideReport {
     /// Heading change over the movement, degrees, counter-clockwise seen from above
     /// (gaitmap's `turning_angle`).
     pub turning_angle_deg: f64,
+    /// Which way the foot travelled, degrees counter-clockwise seen from above, against the
+    /// foot (the sensor's x axis laid level at the stride's start): a backward stride reads
+    /// 180° from a forward one, a sideways one 90°; not a compass heading.
+    pub travel_deg: f64,
     /// `walking`, `running` (stance under half the cycle) or `unknown` (not one cycle).
     pub gait: &'static str,
     /// The foot's largest one-way rotation about its pitch axis in the movement (the swing;
@@ -343,7 +347,7 @@ pub struct StrideReport {
 /// Every field of a stride's JSON record (`replay --json`, MCAP's `/strides`, Python's
 /// columns), in the order it is written, with what it holds: `gaitclip docs` writes the list
 /// into docs/host-tool.md, and a test holds it to the serialised record.
-pub const STRIDE_FIELDS: [(&str, &str); 29] = [
+pub const STRIDE_FIELDS: [(&str, &str); 30] = [
     ("index", "stride number from 0 (strides that count)"),
     ("start_s", "start: the stance instant the stride leaves, s in the trace's own clock"),
     ("end_s", "end: the next stance instant, s"),
@@ -366,6 +370,7 @@ pub const STRIDE_FIELDS: [(&str, &str); 29] = [
     ("cadence_spm", "steps per minute (two per cycle of the instrumented foot)"),
     ("max_sensor_lift_m", "highest point of the sensor above its start, m"),
     ("turning_angle_deg", "heading change over the movement, degrees, counter-clockwise seen from above"),
+    ("travel_deg", "direction of travel against the foot (the sensor's x axis laid level), degrees, counter-clockwise: backward 180° from forward, sideways 90°"),
     ("gait", "`walking`, `running`, `stairs_up`, `stairs_down` or `unknown`"),
     ("swing_deg", "the foot's largest one-way rotation about its pitch axis in the movement, degrees"),
     ("still_before_s", "since the last stride that counted: time at rest, s"),
@@ -788,6 +793,7 @@ pub fn report(s: Stride, config: Config, t_s: &impl Fn(u32) -> f64) -> StrideRep
         cadence_spm: s.gait.cadence_spm,
         max_sensor_lift_m: s.max_sensor_lift_mm as f64 / 1000.0,
         turning_angle_deg: s.turning_angle_cdeg as f64 / 100.0,
+        travel_deg: s.travel_cdeg as f64 / 100.0,
         gait: s.gait.gait.name(),
         swing_deg: s.swing_deg,
         still_before_s: s.between.still_ms as f64 / 1000.0,

@@ -2,7 +2,8 @@
 //! ([`gaitclip_host::reference::cycle_ref`]): every stride of every trial of the three datasets, at the
 //! MPU6050's widest ranges, at ±250 °/s (where nearly every stride clips and the tilt
 //! is put back on the clipped samples) and at ±8 g and ±4 g (where the accelerometer's heel
-//! strikes and push-offs clip and their loss is put back), within 1 mm of the twin.
+//! strikes and push-offs clip and their loss is put back), within 1 mm of the twin, and their
+//! direction of travel within what 1 mm allows.
 
 use gaitclip::sensor::sample::{AccelRange, GyroRange};
 use gaitclip_host::io::datasets::root_or_skip;
@@ -45,8 +46,22 @@ fn cycle_strides_match_the_f64_twin_within_1_mm() {
                 if s.flags.valid() {
                     valid += 1;
                 }
-                match cycle_ref::zupt_m(&run, k) {
-                    Ok(m) => {
+                match cycle_ref::horizontal(&run, k) {
+                    Ok(h) => {
+                        let m = h.norm();
+                        // The direction of travel agrees as far as 1 mm allows, plus the
+                        // CORDIC's centidegree.
+                        if m >= 0.1 {
+                            let twin = h.y.atan2(h.x).to_degrees();
+                            let core = s.travel_cdeg as f64 / 100.0;
+                            let d = (core - twin + 540.0).rem_euclid(360.0) - 180.0;
+                            let bound = (1e-3 / m).to_degrees() + 0.01;
+                            assert!(
+                                d.abs() <= bound,
+                                "{name} {} stride {k}: travel core {core}°, f64 {twin:.3}°",
+                                trial.name
+                            );
+                        }
                         let e = (s.zupt_um as f64 / 1e6 - m).abs();
                         assert!(
                             e <= 1e-3,

@@ -3,15 +3,21 @@
 //! `trials.csv`).
 //!
 //! A course has no per-stride truth, only the lengths walked, so the strides are split into
-//! the course's parts by the direction the foot points, from the core's own heading change per
-//! stride (`turning_angle_deg`, the ZUPT integration's): a stride that turns the foot by at
-//! least [`TURN_DEG`] is a **turning step** (a pivot at a stand; it walks no part of the
-//! course's geometry and is reported apart), and a stride whose heading, summed from the
-//! start, lies more than [`TURN_DEG`] from the median heading of the part so far starts the
-//! next part. The first part is the forward one (slow walk to sprint), the second the
-//! backward one (the walker turns round), every later one sideways (the walker turns a
-//! quarter, and round again between left and right). [`TURN_DEG`] is the step check's turn on
-//! the spot ([`gaitclip::detect::step_check::TURN_STEP_MIN_DEG`]), not fitted to a course.
+//! the course's parts by which way each one travelled against the foot: the core's
+//! `travel_deg` (the direction of the stride's displacement from the sensor's x axis laid
+//! level at its start, fixed to the foot by the mounting: a backward stride reads 180° from a
+//! forward one, a sideways one 90°). The course's forward direction is the circular median
+//! over its strides of at least [`MEDIAN_MIN_M`] (most of a course is walked forward); a
+//! stride within [`FORWARD_MAX_DEG`] of it goes forward, beyond [`BACKWARD_MIN_DEG`] backward,
+//! between them sideways. The parts follow one another (forward, backward, sideways): the
+//! backward part starts at the first of [`PART_RUN`] strides in a row that go backward, the
+//! sideways part at the first of as many that go sideways, and every stride belongs to the
+//! part it falls in by time (a stride split in two whose halves point elsewhere stays in its
+//! part). Turning steps (the foot turned by [`TURN_DEG`] or more) are counted in their part
+//! and listed apart as well. The bounds halve the angles between the three directions; none
+//! is fitted to a course. Until 2026-12-07 the split followed the heading summed from the
+//! strides' turning angles and left turning steps out of every part: that put the sidesteps
+//! after a turn outside the sideways part (−7 to −65 % where this split finds −15 to +1 %).
 //!
 //! Also per course: the strides by gait class, |climb| per stride (the courses are level, so
 //! any climb is integration error: its median, p95, max and the strides over
@@ -30,8 +36,18 @@ use crate::io::trace::Ranges;
 use crate::replay::{self, StrideReport};
 use crate::{io::csv_trace, replay::Summary};
 
-/// A change of direction, degrees: a turning step, or the start of the next part.
+/// A turning step turns the foot by this much or more, degrees (the step check's turn on
+/// the spot).
 pub const TURN_DEG: f64 = gaitclip::detect::step_check::TURN_STEP_MIN_DEG as f64;
+/// A stride within this of the course's forward direction travels forward, degrees.
+pub const FORWARD_MAX_DEG: f64 = 45.0;
+/// A stride this far or further from it travels backward, degrees.
+pub const BACKWARD_MIN_DEG: f64 = 135.0;
+/// Strides this long or longer set the forward direction, m (a turning pivot's few
+/// centimetres point anywhere).
+pub const MEDIAN_MIN_M: f64 = 0.3;
+/// Strides in a row that start the next part.
+pub const PART_RUN: usize = 3;
 /// |climb| over this on a level course is reported (issue 45's check), m.
 pub const CLIMB_CHECK_M: f64 = 0.3;
 
@@ -59,31 +75,59 @@ pub enum Part {
     Backward,
     /// Every later one.
     Sideways,
-    /// A stride that turned the foot by [`TURN_DEG`] or more.
-    Turning,
 }
 
-/// Each stride's part, from its heading change (degrees, counter-clockwise), in order.
-pub fn split(turning_deg: &[f64]) -> Vec<Part> {
-    let mut heading = 0.0;
-    let mut part = 0usize;
-    let mut in_part: Vec<f64> = Vec::new();
-    turning_deg
+/// Which way a stride went against the course's forward direction `forward_deg`.
+pub fn direction(travel_deg: f64, forward_deg: f64) -> Part {
+    let off = (travel_deg - forward_deg + 540.0).rem_euclid(360.0) - 180.0;
+    if off.abs() < FORWARD_MAX_DEG {
+        Part::Forward
+    } else if off.abs() >= BACKWARD_MIN_DEG {
+        Part::Backward
+    } else {
+        Part::Sideways
+    }
+}
+
+/// The circular median of `angles_deg`: the one of them nearest to all the others (the least
+/// sum of arc distances), which the larger group of directions decides; 0 for none.
+pub fn circular_median(angles_deg: &[f64]) -> f64 {
+    let arc = |a: f64, b: f64| ((a - b + 540.0).rem_euclid(360.0) - 180.0).abs();
+    angles_deg
         .iter()
-        .map(|&turn| {
-            heading += turn;
-            if turn.abs() >= TURN_DEG {
-                return Part::Turning;
-            }
-            if !in_part.is_empty() && (heading - median(&in_part)).abs() > TURN_DEG {
-                part += 1;
-                in_part.clear();
-            }
-            in_part.push(heading);
-            match part {
-                0 => Part::Forward,
-                1 => Part::Backward,
-                _ => Part::Sideways,
+        .map(|&a| (angles_deg.iter().map(|&b| arc(a, b)).sum::<f64>(), a))
+        .min_by(|x, y| x.0.total_cmp(&y.0))
+        .map_or(0.0, |(_, a)| a)
+}
+
+/// Each stride's part, in order, from its direction of travel (`travel_deg`) and length
+/// (`length_m`): see the module.
+pub fn split(travel_deg: &[f64], length_m: &[f64]) -> Vec<Part> {
+    let long: Vec<f64> = travel_deg
+        .iter()
+        .zip(length_m)
+        .filter(|(_, &l)| l >= MEDIAN_MIN_M)
+        .map(|(&a, _)| a)
+        .collect();
+    let forward = circular_median(&long);
+    let dirs: Vec<Part> = travel_deg.iter().map(|&a| direction(a, forward)).collect();
+    // The first of PART_RUN strides in a row going `want`, from `from` on.
+    let run_start = |from: usize, want: Part| {
+        (from..dirs.len()).find(|&i| {
+            i + PART_RUN <= dirs.len() && dirs[i..i + PART_RUN].iter().all(|&d| d == want)
+        })
+    };
+    let n = dirs.len();
+    let backward = run_start(0, Part::Backward).unwrap_or(n);
+    let sideways = run_start(backward.min(n), Part::Sideways).unwrap_or(n);
+    (0..n)
+        .map(|i| {
+            if i < backward {
+                Part::Forward
+            } else if i < sideways {
+                Part::Backward
+            } else {
+                Part::Sideways
             }
         })
         .collect()
@@ -144,7 +188,7 @@ pub fn report(root: &Path) -> Result<String> {
         Column::right("forward"),
         Column::right("backward"),
         Column::right("sideways"),
-        Column::right("turning steps (m)"),
+        Column::right("of which turning steps (m)"),
         Column::right("strides: walking / running / stairs / unknown"),
         Column::right("|climb| median / p95 / max m"),
         Column::right("over 0.3 m"),
@@ -153,11 +197,14 @@ pub fn report(root: &Path) -> Result<String> {
     let mut totals = Vec::new();
     for c in &courses {
         let parts = split(
-            &c.strides
-                .iter()
-                .map(|s| s.turning_angle_deg)
-                .collect::<Vec<_>>(),
+            &c.strides.iter().map(|s| s.travel_deg).collect::<Vec<_>>(),
+            &c.strides.iter().map(|s| s.length_m).collect::<Vec<_>>(),
         );
+        let turning: Vec<&StrideReport> = c
+            .strides
+            .iter()
+            .filter(|s| s.turning_angle_deg.abs() >= TURN_DEG)
+            .collect();
         let mut by_part: BTreeMap<Part, (usize, f64)> = BTreeMap::new();
         for (s, p) in c.strides.iter().zip(&parts) {
             let e = by_part.entry(*p).or_default();
@@ -191,7 +238,11 @@ pub fn report(root: &Path) -> Result<String> {
                 against(part(Part::Sideways).1, c.truth.sideways_m),
                 part(Part::Sideways).0
             ),
-            format!("{} ({:.2})", part(Part::Turning).0, part(Part::Turning).1),
+            format!(
+                "{} ({:.2})",
+                turning.len(),
+                turning.iter().map(|s| s.length_m).sum::<f64>()
+            ),
             format!(
                 "{} / {} / {} / {}",
                 gait(&["walking"]),
@@ -226,7 +277,7 @@ pub fn report(root: &Path) -> Result<String> {
     }
     let abs: Vec<f64> = totals.iter().map(|e| e.abs()).collect();
     Ok(format!(
-        "`esangeni_course`, each course's reported distance (the foot pod's total: every stride with a length) against its geometry, and the parts split by the foot's heading (forward, then backward, then sideways; turning steps apart), m / m (error), (strides):\n\n{}\n|total error|: median {:.1} %, worst {:.1} % over {} courses.\n",
+        "`esangeni_course`, each course's reported distance (the foot pod's total: every stride with a length) against its geometry, and the parts split by each stride's direction of travel against the foot (forward, then backward, then sideways; turning steps in their part and listed apart), m / m (error), (strides):\n\n{}\n|total error|: median {:.1} %, worst {:.1} % over {} courses.\n",
         t.render(),
         median(&abs),
         abs.iter().copied().fold(0.0, f64::max),
@@ -239,25 +290,33 @@ mod tests {
     use super::*;
 
     #[test]
-    fn parts_follow_the_heading_and_turning_steps_stand_apart() {
-        // Forward with a little drift, a 180° turn in two pivots, backward, a quarter turn,
-        // sideways, a half turn, sideways the other way.
-        let turns = [
-            2.0, -3.0, 5.0, 4.0, 20.0, -18.0, // forward (a 20° wobble is no new part)
-            90.0, 85.0, // pivots
-            3.0, -2.0, 1.0, // backward
-            25.0, 25.0, 25.0, 20.0, // a turn spread over small steps: a new part
-            -1.0, 2.0, // sideways
-            170.0, 1.0, -2.0, // sideways again
+    fn parts_follow_the_direction_of_travel_in_runs() {
+        // Forward (mounted 100° off the sensor's x), with a split stride whose halves point
+        // back; a turnaround; backward; a quarter turn; sideways one way, then the other.
+        let f = 100.0;
+        #[rustfmt::skip]
+        let travel = [
+            f + 3.0, f - 5.0, f + 2.0, f - 180.0, f + 170.0, f + 1.0, f - 2.0, f + 4.0, f - 1.0,
+            f + 2.0, f + 0.0, f - 3.0, // forward, most of a course, one stride split in two
+            f + 60.0, // the turnaround's pivot: in its part
+            f + 178.0, f - 175.0, f + 180.0, f + 172.0, // backward
+            f + 95.0, f + 88.0, f + 92.0, // sideways
+            f - 90.0, f - 85.0, // sideways the other way
         ];
+        let lengths = [1.2; 22];
         use Part::*;
+        let parts = split(&travel, &lengths);
         assert_eq!(
-            split(&turns),
+            parts,
             vec![
-                Forward, Forward, Forward, Forward, Forward, Forward, Turning, Turning, Backward,
-                Backward, Backward, Backward, Sideways, Sideways, Sideways, Sideways, Sideways,
-                Turning, Sideways, Sideways
+                Forward, Forward, Forward, Forward, Forward, Forward, Forward, Forward, Forward,
+                Forward, Forward, Forward, Forward, Backward, Backward, Backward, Backward,
+                Sideways, Sideways, Sideways, Sideways, Sideways
             ]
         );
+        assert_eq!(circular_median(&[350.0, 10.0, 5.0, -5.0, 170.0]), 5.0);
+        assert_eq!(direction(f + 200.0, f), Backward);
+        assert_eq!(direction(f - 50.0, f), Sideways);
+        assert_eq!(direction(f + 40.0, f), Forward);
     }
 }

@@ -18,6 +18,7 @@ use anyhow::Result;
 use gaitclip::record::gait::Gait;
 use gaitclip::record::stride::StrideFlags;
 
+use crate::eval::course::{circular_median, direction, Part, MEDIAN_MIN_M};
 use crate::eval::length_eval::SPEED_BINS;
 use crate::eval::markdown::{cm_cell, Table};
 use crate::eval::matching::{self, Detected, Scored};
@@ -48,6 +49,11 @@ pub struct Instant {
     /// The Vicon marker's height change over the stride (its end instant's row less its
     /// start's), m: the floor is level, so about zero.
     pub vicon_climb_m: f64,
+    /// Which way it travelled against the trial's forward direction
+    /// ([`crate::eval::course::direction`]).
+    pub direction: Part,
+    /// The Vicon's length, m.
+    pub length_m: f64,
 }
 
 /// The instants of every clean matched stride of `pyshoe_vicon`.
@@ -66,6 +72,15 @@ pub fn instants(root: &std::path::Path) -> Result<Vec<Instant>> {
             continue;
         };
         let dt = p.clock.period_s;
+        // The trial's forward direction: where most of its strides travel (a trial walks
+        // forward mostly; its backward and sideways strides read 180° and 90° from it).
+        let forward = circular_median(
+            &strides
+                .iter()
+                .filter(|s| s.zupt_um >= (MEDIAN_MIN_M * 1e6) as u32)
+                .map(|s| s.travel_cdeg as f64 / 100.0)
+                .collect::<Vec<_>>(),
+        );
         let per_radps = ranges.gyro_counts_per_radps();
         for (i, c) in scored.iter().enumerate() {
             let Scored::Found(j) = *c else { continue };
@@ -108,6 +123,8 @@ pub fn instants(root: &std::path::Path) -> Result<Vec<Instant>> {
                 running: s.gait.gait == Gait::Running,
                 climb_m: s.climb_mm as f64 / 1000.0,
                 vicon_climb_m,
+                direction: direction(s.travel_cdeg as f64 / 100.0, forward),
+                length_m: len,
             });
         }
     }
@@ -211,11 +228,39 @@ pub fn report(root: &std::path::Path) -> Result<String> {
             ),
         ]);
     }
+    // Backward and sideways strides: the trial's forward direction from its own strides.
+    let mut d = Table::new([
+        "direction of travel against the foot",
+        "strides",
+        "ZUPT RMSE / bias cm",
+        "their sum against the Vicon's",
+    ]);
+    for (part, name) in [
+        (Part::Forward, "forward (within 45°)"),
+        (Part::Sideways, "sideways (45–135°)"),
+        (Part::Backward, "backward (beyond 135°)"),
+    ] {
+        let b: Vec<&Instant> = all.iter().filter(|x| x.direction == part).collect();
+        let errors: Vec<f64> = b.iter().map(|x| x.zupt_error_m).collect();
+        let truth: f64 = b.iter().map(|x| x.length_m).sum();
+        d.row([
+            name.to_string(),
+            b.len().to_string(),
+            cm_cell(&errors),
+            if truth > 0.0 {
+                format!("{:+.1} %", 100.0 * errors.iter().sum::<f64>() / truth)
+            } else {
+                "–".into()
+            },
+        ]);
+    }
     Ok(format!(
         "`pyshoe_vicon`, clean matched strides by the Vicon stride's speed; the instant is the stance instant our stride starts at:\n\n{}\n\
-         The same strides by the climb our integration gives them (the Vicon marker's own climb beside it), against the Vicon's length:\n\n{}",
+         The same strides by the climb our integration gives them (the Vicon marker's own climb beside it), against the Vicon's length:\n\n{}\n\
+         The same strides by which way they travelled against the foot (`travel_deg` against the circular median of the trial's strides):\n\n{}",
         t.render(),
-        c.render()
+        c.render(),
+        d.render()
     ))
 }
 

@@ -133,6 +133,19 @@ pub enum Skipped {
 
 /// The twin's horizontal ZUPT distance of stride `k` of `run`, m.
 pub fn zupt_m(run: &CoreRun, k: usize) -> Result<f64, Skipped> {
+    horizontal(run, k).map(|p| p.norm())
+}
+
+/// The twin's direction of travel of stride `k` of `run` (the core's
+/// [`gaitclip::record::stride::Stride::travel_cdeg`]), degrees counter-clockwise from the x
+/// axis of the level frame of its start.
+pub fn travel_deg(run: &CoreRun, k: usize) -> Result<f64, Skipped> {
+    horizontal(run, k).map(|p| p.y.atan2(p.x).to_degrees())
+}
+
+/// The twin's horizontal ZUPT displacement of stride `k` of `run`, level frame of its start,
+/// m.
+pub fn horizontal(run: &CoreRun, k: usize) -> Result<nalgebra::Vector2<f64>, Skipped> {
     let s = &run.strides[k];
     if !s.flags.valid() || s.flags.has(StrideFlags::BRIDGED) {
         return Err(Skipped::Flagged);
@@ -172,7 +185,17 @@ pub fn zupt_m(run: &CoreRun, k: usize) -> Result<f64, Skipped> {
         Vector3::new(h_m * wl.y, -h_m * wl.x, 0.0)
     };
 
-    let mut q = UnitQuaternion::rotation_between(&up0, &Vector3::z()).ok_or(Skipped::Missing)?;
+    // The core's level frame (`QuatQ30::level_from_up`): a sensor hanging upside down is
+    // first turned 180° about x, so that the frame's x axis is the sensor's laid level (the
+    // direction of travel is measured from it); the shortest rotation onto +z after that.
+    let flip = if up0.z < 0.0 {
+        UnitQuaternion::from_axis_angle(&Vector3::x_axis(), std::f64::consts::PI)
+    } else {
+        UnitQuaternion::identity()
+    };
+    let mut q = UnitQuaternion::rotation_between(&(flip * up0), &Vector3::z())
+        .ok_or(Skipped::Missing)?
+        * flip;
     let mut v = rolling(&q, omega(&run.sample(i0)?, cal0.gyro_bias));
     let mut p = Vector3::zeros();
     let config_rails = run.config.rails;
@@ -286,7 +309,7 @@ pub fn zupt_m(run: &CoreRun, k: usize) -> Result<f64, Skipped> {
             p.y += h.y * w / clipped as f64 * leak * dt * dt / 2.0;
         }
     }
-    Ok(p.xy().norm())
+    Ok(p.xy())
 }
 
 /// [`gaitclip::detect::clipping::RailRun`] in `f64`: the parabola's area above the rail per clipped
