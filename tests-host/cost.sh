@@ -36,12 +36,55 @@ report=$(cargo run --release --quiet --bin gaitclip -- cost \
   --gaitmap target/cost/gaitmap.json \
   --datasets "$datasets")
 
+# A week at 100 Hz through `gaitclip replay` (a CSV streams in constant memory): 60 M samples
+# of `ipol_gait_events`' walks, one after another on a clean 100 Hz clock, generated here
+# (≈ 4.5 GB, deleted after) and replayed under GNU time for the peak resident memory.
+echo "== a week at 100 Hz in constant memory (60 M samples)" >&2
+if [ ! -x /usr/bin/time ]; then
+  echo "GNU time is missing; installing it from Debian (apt-get install time)" >&2
+  sudo_cmd=""; [ "$(id -u)" -eq 0 ] || sudo_cmd="sudo"
+  $sudo_cmd apt-get install -y -qq time >&2
+fi
+week="$root/tests-host/target/cost/week.csv"
+long_samples=60000000
+python3 - "$datasets/ipol_gait_events" "$week" "$long_samples" <<'PY'
+import glob, os, sys
+src, out, n = sys.argv[1], sys.argv[2], int(sys.argv[3])
+rows = []
+for f in sorted(glob.glob(os.path.join(src, "*.csv"))):
+    if os.path.basename(f) in ("events.csv", "trials.csv"):
+        continue
+    with open(f) as fh:
+        next(fh)
+        rows.extend(line.rstrip("\n").split(",", 1)[1] for line in fh)
+with open(out, "w") as o:
+    o.write("t_s,acc_x,acc_y,acc_z,gyr_x,gyr_y,gyr_z\n")
+    block = 100_000
+    for a in range(0, n, block):
+        o.write("".join(f"{i / 100!r},{rows[i % len(rows)]}\n" for i in range(a, min(n, a + block))))
+PY
+week_bytes=$(stat -c %s "$week")
+long_out=$(mktemp)
+/usr/bin/time -f "%M %e" -o "$long_out" "target/$host/release/gaitclip" replay --json "$week" \
+  | tail -1 > target/cost/week-summary.json
+read -r long_kb long_s < "$long_out"
+rm -f "$week" "$long_out"
+long_strides=$(python3 -c 'import json,sys; print(json.load(open(sys.argv[1]))["summary"]["strides"])' target/cost/week-summary.json)
+
 cpu=$(sed -n 's/^model name[[:space:]]*: //p' /proc/cpuinfo | head -1)
 out=$(mktemp)
 {
 echo "Measured on $(date -u +%Y-%m-%d) on ${cpu:-$(uname -m)} ($(nproc) cores, $(uname -m)); $(rustc --version | cut -d' ' -f1-2); $(qemu-system-arm --version | head -1 | sed 's/ (.*//'); $(python3 --version)."
 echo
 echo "$report"
+echo
+echo "### Constant memory"
+echo
+echo "\`gaitclip replay --json\` of a week at 100 Hz: $long_samples samples of \`ipol_gait_events\`' walks one after another on a clean clock, a $((week_bytes / 1000000)) MB CSV (the spool beside it, 64 bytes a sample, on disk):"
+echo
+echo "| samples | strides | peak resident memory | wall time | samples/s |"
+echo "|---:|---:|---:|---:|---:|"
+python3 -c 'import sys; n,k,kb,s=int(sys.argv[1]),sys.argv[2],int(sys.argv[3]),float(sys.argv[4]); print(f"| {n} | {k} | {kb/1024:.1f} MiB | {s:.1f} s | {n/s:,.0f} |".replace(",", " "))' "$long_samples" "$long_strides" "$long_kb" "$long_s"
 } > "$out"
 cat "$out"
 # The tables go into docs/cost.md between its markers: re-measuring is this command, not an

@@ -23,6 +23,7 @@ use gaitclip_host::io::recording::{self, ReadError};
 use gaitclip_host::io::trace::{GivenRanges, ImuSample, Ranges, Trace};
 use gaitclip_host::io::units::{self, Front, Units};
 use gaitclip_host::replay::{self, StrideReport};
+use gaitclip_host::stream::{StreamError, Streamed};
 use numpy::{IntoPyArray, PyReadonlyArray1};
 use pyo3::exceptions::{PyFileNotFoundError, PyValueError};
 use pyo3::prelude::*;
@@ -91,6 +92,19 @@ fn run<'py>(
             replay::replay_clocked(&trace, Ranges::default(), o.detector, o.model, o.all_models)
         })
         .map_err(|e| PyValueError::new_err(e.to_string()))?;
+    columns(py, &strides, &summary, &clock, o, row_of)
+}
+
+/// The strides' columns and the summary's JSON (see [`run`]).
+fn columns<'py>(
+    py: Python<'py>,
+    strides: &[StrideReport],
+    summary: &replay::Summary,
+    clock: &SampleClock,
+    o: Options,
+    row_of: impl Fn(u32) -> u64,
+) -> PyResult<(Bound<'py, PyDict>, String)> {
+    let clock = clock.clone();
     let at = |c: &SampleClock, n: u32| row_of(c.row_of_number(n)) as i64;
     let f = |get: fn(&StrideReport) -> f64| -> Vec<f64> { strides.iter().map(get).collect() };
     let cols = PyDict::new(py);
@@ -184,7 +198,7 @@ fn run<'py>(
         .collect();
     put_f("row_pre_ic", pre_ic)?;
     let summary =
-        serde_json::to_string(&summary).map_err(|e| PyValueError::new_err(e.to_string()))?;
+        serde_json::to_string(summary).map_err(|e| PyValueError::new_err(e.to_string()))?;
     Ok((cols, summary))
 }
 
@@ -349,10 +363,29 @@ fn replay_path<'py>(
         units,
         front: Front::Python,
     };
-    let mut trace = py.detach(|| read(&path, &how))?;
-    trace.given.acc_g = acc_range_g.or(trace.given.acc_g);
-    trace.given.gyro_dps = gyro_range_dps.or(trace.given.gyro_dps);
-    run(py, trace, o, |row| row as u64)
+    if recording::is_mcap(&path) {
+        let mut trace = py.detach(|| read(&path, &how))?;
+        trace.given.acc_g = acc_range_g.or(trace.given.acc_g);
+        trace.given.gyro_dps = gyro_range_dps.or(trace.given.gyro_dps);
+        return run(py, trace, o, |row| row as u64);
+    }
+    // A CSV file is replayed as a stream, in constant memory (`gaitclip_host::stream`).
+    let (strides, summary, clock) = py.detach(|| -> PyResult<_> {
+        let mut s = Streamed::open(&path, &how).map_err(read_error)?;
+        s.given.acc_g = acc_range_g.or(s.given.acc_g);
+        s.given.gyro_dps = gyro_range_dps.or(s.given.gyro_dps);
+        let mut strides = Vec::new();
+        let (summary, clock) = s
+            .replay(Ranges::default(), o.detector, o.model, o.all_models, |r| {
+                strides.push(r)
+            })
+            .map_err(|e| match e {
+                StreamError::Read(e) => read_error(e),
+                StreamError::Replay(e) => PyValueError::new_err(e.to_string()),
+            })?;
+        Ok((strides, summary, clock))
+    })?;
+    columns(py, &strides, &summary, &clock, o, |row| row as u64)
 }
 
 fn not_found(path: &Path, source: &std::io::Error) -> PyErr {
@@ -365,11 +398,16 @@ fn not_found(path: &Path, source: &std::io::Error) -> PyErr {
 }
 
 fn read(path: &Path, o: &recording::ReadOptions) -> PyResult<Trace> {
-    recording::read(path, o).map_err(|e| match &e {
+    recording::read(path, o).map_err(read_error)
+}
+
+/// A reading error as Python's: a file not found as `FileNotFoundError`.
+fn read_error(e: ReadError) -> PyErr {
+    match &e {
         ReadError::Csv(CsvError::Io { path, source })
         | ReadError::Mcap(McapError::Io { path, source }) => not_found(path, source),
         _ => PyValueError::new_err(e.to_string()),
-    })
+    }
 }
 
 /// The detector and model names the core knows, and the default model.

@@ -13,3 +13,4 @@ pub mod train;
 pub mod pod;
 pub mod progress;
 pub mod replay;
+pub mod stream;

@@ -494,19 +494,36 @@ pub struct CoreRun {
 
 /// [`core_run_with_stats`] and the rest of what the pipeline tells ([`CoreRun`]).
 pub fn core_run_full(samples: &[RawSample], gaps: &[Gap], config: Config) -> CoreRun {
+    let mut strides = Vec::new();
+    let mut r = core_run_each(samples.iter().copied(), gaps, config, |s, stats| {
+        strides.push((s, stats))
+    });
+    r.strides = strides;
+    r
+}
+
+/// [`core_run_full`] over counts read as a stream: each stride, with its phase statistics,
+/// goes to `stride` as the pipeline hands it out; the run returned holds everything else
+/// (its `strides` empty).
+pub fn core_run_each(
+    samples: impl Iterator<Item = RawSample>,
+    gaps: &[Gap],
+    config: Config,
+    mut stride: impl FnMut(Stride, StrideStats),
+) -> CoreRun {
     let mut p = Pipeline::new(config);
     let mut r = CoreRun::default();
-    let with_stats = |p: &Pipeline, s: Stride| (s, p.stats(&s).copied().unwrap_or_default());
+    let mut out = |p: &Pipeline, s: Stride| stride(s, p.stats(&s).copied().unwrap_or_default());
     let mut next_gap = gaps.iter().peekable();
-    for (i, s) in samples.iter().enumerate() {
+    for (i, s) in samples.enumerate() {
         while let Some(g) = next_gap.next_if(|g| g.before <= i) {
             if let Some(st) = p.gap(g.missing) {
-                r.strides.push(with_stats(&p, st));
+                out(&p, st);
             }
             r.rejected.extend(p.take_rejected());
         }
-        if let Some(st) = p.process(s) {
-            r.strides.push(with_stats(&p, st));
+        if let Some(st) = p.process(&s) {
+            out(&p, st);
         }
         r.rejected.extend(p.take_rejected());
     }
@@ -514,7 +531,7 @@ pub fn core_run_full(samples: &[RawSample], gaps: &[Gap], config: Config) -> Cor
         let st = p.finish();
         r.rejected.extend(p.take_rejected());
         match st {
-            Some(st) => r.strides.push(with_stats(&p, st)),
+            Some(st) => out(&p, st),
             None => break,
         }
     }
@@ -523,6 +540,128 @@ pub fn core_run_full(samples: &[RawSample], gaps: &[Gap], config: Config) -> Cor
     r.between = p.between();
     r.dropped = gaitclip::detect::seam::StepDetector::dropped(p.detector());
     r
+}
+
+/// The summary's counts of the strides, taken one by one in the order the core hands them
+/// out (the distance summed in that order).
+#[derive(Clone, Copy, Debug)]
+pub struct StrideTally {
+    strides: usize,
+    valid: usize,
+    bridged: usize,
+    gap: usize,
+    estimated: usize,
+    unestimated: usize,
+    distance_m: f64,
+    estimated_distance_m: f64,
+}
+
+impl Default for StrideTally {
+    /// No stride: the sums start where `Iterator::sum` of `f64` starts (−0.0), so that an
+    /// empty recording reports what it reported when the strides were summed in a list.
+    fn default() -> Self {
+        StrideTally {
+            strides: 0,
+            valid: 0,
+            bridged: 0,
+            gap: 0,
+            estimated: 0,
+            unestimated: 0,
+            distance_m: -0.0,
+            estimated_distance_m: -0.0,
+        }
+    }
+}
+
+impl StrideTally {
+    /// Counts stride `s`.
+    pub fn add(&mut self, s: &Stride) {
+        self.strides += 1;
+        self.valid += usize::from(s.flags.valid());
+        self.bridged += usize::from(s.flags.has(StrideFlags::BRIDGED));
+        self.gap += usize::from(s.flags.has(StrideFlags::GAP));
+        self.estimated += usize::from(s.flags.has(StrideFlags::ESTIMATED));
+        self.unestimated += usize::from(!s.flags.counts_distance());
+        if s.flags.counts_distance() {
+            self.distance_m += s.length_mm as f64 / 1000.0;
+        }
+        if s.flags.has(StrideFlags::ESTIMATED) {
+            self.estimated_distance_m += s.length_mm as f64 / 1000.0;
+        }
+    }
+}
+
+/// What a summary says of a recording besides its strides: how it was read and prepared.
+#[derive(Clone, Debug)]
+pub struct Preparation<'a> {
+    /// Rows read and re-sent samples dropped.
+    pub read: (usize, usize),
+    /// The recovered clock.
+    pub clock: &'a SampleClock,
+    /// The rails.
+    pub rails: &'a RailsReport,
+    /// The nominal rate, Hz.
+    pub nominal_hz: f64,
+    /// The core's rate.
+    pub rate: SampleRate,
+}
+
+impl Preparation<'_> {
+    /// The summary of `run` (its strides counted in `tally`).
+    pub fn summary(&self, run: &CoreRun, tally: &StrideTally) -> Summary {
+        let h = run.holes;
+        let clock = self.clock;
+        Summary {
+            samples_read: self.read.0,
+            repeated_dropped: self.read.1,
+            holes: clock.holes.len(),
+            lost_samples: clock.lost(),
+            bridged: h.bridged,
+            bridged_samples: h.bridged_samples,
+            gaps: h.gaps(),
+            gap_samples: h.gap_samples(),
+            gaps_filled: h.filled,
+            strides: tally.strides,
+            valid_strides: tally.valid,
+            bridged_strides: tally.bridged,
+            gap_strides: tally.gap,
+            estimated_strides: tally.estimated,
+            unestimated_strides: tally.unestimated,
+            distance_m: tally.distance_m,
+            estimated_distance_m: tally.estimated_distance_m,
+            rails: self.rails.axes.clone(),
+            nominal_rate_hz: self.nominal_hz,
+            clock_rate_hz: clock.rate_hz(),
+            clock_offset_s: clock.offset_s,
+            core_rate_hz: self.rate.millihertz() as f64 / 1000.0,
+            retimed_stamps: clock.retimed,
+            max_stamp_offset_ms: clock.max_offclock_s * 1e3,
+            rejected: Rejection::ALL
+                .iter()
+                .map(|r| (r.name(), run.rejected_counts.by_reason[*r as usize]))
+                .collect(),
+            unchecked_strides: run.rejected_counts.unchecked,
+            still_min: run.between.still_ms as f64 / 60_000.0,
+            moving_min: run.between.moving_ms as f64 / 60_000.0,
+            rejected_movements: run
+                .rejected
+                .iter()
+                .map(|m| RejectedReport {
+                    start_s: clock.t_s(m.start),
+                    end_s: clock.t_s(m.end),
+                    movement_s: (clock.t_s(m.movement.0), clock.t_s(m.movement.1)),
+                    reason: m.reason.name(),
+                    swing_deg: m.swing_deg,
+                    swing_peak_rad_s: m.swing_peak_mradps as f64 / 1000.0,
+                    rest_before: m.rest.0,
+                    rest_after: m.rest.1,
+                    horizontal_m: m.horizontal_mm as f64 / 1000.0,
+                    climb_m: m.climb_mm as f64 / 1000.0,
+                    lift_m: m.lift_mm as f64 / 1000.0,
+                })
+                .collect(),
+        }
+    }
 }
 
 /// A trace made ready for the core: its counts, its recovered sample clock (with the holes
@@ -555,78 +694,18 @@ impl Prepared {
 
     /// [`Prepared::strides_with_stats`] and the summary of what was done to the samples.
     pub fn run(&self, config: Config) -> (Vec<(Stride, StrideStats)>, Summary) {
-        let run = core_run_full(&self.counts, &self.clock.holes, config);
-        let (strides, h) = (run.strides, run.holes);
-        let summary = Summary {
-            samples_read: self.read.0,
-            repeated_dropped: self.read.1,
-            holes: self.clock.holes.len(),
-            lost_samples: self.clock.lost(),
-            bridged: h.bridged,
-            bridged_samples: h.bridged_samples,
-            gaps: h.gaps(),
-            gap_samples: h.gap_samples(),
-            gaps_filled: h.filled,
-            strides: strides.len(),
-            valid_strides: strides.iter().filter(|s| s.0.flags.valid()).count(),
-            bridged_strides: strides
-                .iter()
-                .filter(|s| s.0.flags.has(StrideFlags::BRIDGED))
-                .count(),
-            gap_strides: strides
-                .iter()
-                .filter(|s| s.0.flags.has(StrideFlags::GAP))
-                .count(),
-            estimated_strides: strides
-                .iter()
-                .filter(|s| s.0.flags.has(StrideFlags::ESTIMATED))
-                .count(),
-            unestimated_strides: strides
-                .iter()
-                .filter(|s| !s.0.flags.counts_distance())
-                .count(),
-            distance_m: strides
-                .iter()
-                .filter(|s| s.0.flags.counts_distance())
-                .map(|s| s.0.length_mm as f64 / 1000.0)
-                .sum(),
-            estimated_distance_m: strides
-                .iter()
-                .filter(|s| s.0.flags.has(StrideFlags::ESTIMATED))
-                .map(|s| s.0.length_mm as f64 / 1000.0)
-                .sum(),
-            rails: self.rails.axes.clone(),
-            nominal_rate_hz: self.nominal_hz,
-            clock_rate_hz: self.clock.rate_hz(),
-            clock_offset_s: self.clock.offset_s,
-            core_rate_hz: self.rate.millihertz() as f64 / 1000.0,
-            retimed_stamps: self.clock.retimed,
-            max_stamp_offset_ms: self.clock.max_offclock_s * 1e3,
-            rejected: Rejection::ALL
-                .iter()
-                .map(|r| (r.name(), run.rejected_counts.by_reason[*r as usize]))
-                .collect(),
-            unchecked_strides: run.rejected_counts.unchecked,
-            still_min: run.between.still_ms as f64 / 60_000.0,
-            moving_min: run.between.moving_ms as f64 / 60_000.0,
-            rejected_movements: run
-                .rejected
-                .iter()
-                .map(|m| RejectedReport {
-                    start_s: self.clock.t_s(m.start),
-                    end_s: self.clock.t_s(m.end),
-                    movement_s: (self.clock.t_s(m.movement.0), self.clock.t_s(m.movement.1)),
-                    reason: m.reason.name(),
-                    swing_deg: m.swing_deg,
-                    swing_peak_rad_s: m.swing_peak_mradps as f64 / 1000.0,
-                    rest_before: m.rest.0,
-                    rest_after: m.rest.1,
-                    horizontal_m: m.horizontal_mm as f64 / 1000.0,
-                    climb_m: m.climb_mm as f64 / 1000.0,
-                    lift_m: m.lift_mm as f64 / 1000.0,
-                })
-                .collect(),
-        };
+        let mut run = core_run_full(&self.counts, &self.clock.holes, config);
+        let strides = std::mem::take(&mut run.strides);
+        let mut tally = StrideTally::default();
+        strides.iter().for_each(|(s, _)| tally.add(s));
+        let summary = Preparation {
+            read: self.read,
+            clock: &self.clock,
+            rails: &self.rails,
+            nominal_hz: self.nominal_hz,
+            rate: self.rate,
+        }
+        .summary(&run, &tally);
         (strides, summary)
     }
 
@@ -748,23 +827,29 @@ pub fn replay_clocked(
         .collect();
     if all_models && detector != Detector::PeakValley {
         for r in &mut out {
-            if r.raw.flags.has(StrideFlags::GAP) {
-                // No length across a gap, from any model.
-                continue;
-            }
-            let f = Features::of(&r.raw, &r.stats, rate);
-            r.lengths_m = Some(
-                Model::ALL
-                    .iter()
-                    .map(|&m| {
-                        let mm = models::predict_mm(m, &f, config.settings, config.params);
-                        (m.name(), mm.unwrap_or(0) as f64 / 1000.0)
-                    })
-                    .collect(),
-            );
+            add_all_models(r, config, rate);
         }
     }
     Ok((out, summary, prepared.clock))
+}
+
+/// Every model's length of `r` (`lengths_m`), from its features at `rate` with `config`; none
+/// across a gap.
+pub fn add_all_models(r: &mut StrideReport, config: Config, rate: SampleRate) {
+    if r.raw.flags.has(StrideFlags::GAP) {
+        // No length across a gap, from any model.
+        return;
+    }
+    let f = Features::of(&r.raw, &r.stats, rate);
+    r.lengths_m = Some(
+        Model::ALL
+            .iter()
+            .map(|&m| {
+                let mm = models::predict_mm(m, &f, config.settings, config.params);
+                (m.name(), mm.unwrap_or(0) as f64 / 1000.0)
+            })
+            .collect(),
+    );
 }
 
 /// The host's report of a core stride `s` made with `config`, times by `t_s` (sample number to

@@ -74,6 +74,8 @@ mod rsc;
 mod rsc_gatt;
 #[path = "sleep_policy.rs"]
 mod sleep_policy;
+#[path = "stream.rs"]
+mod stream;
 #[path = "trace_faults.rs"]
 mod trace_faults;
 #[path = "trained_model.rs"]

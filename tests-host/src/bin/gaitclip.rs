@@ -12,6 +12,7 @@ use gaitclip_host::eval::scoring;
 use gaitclip_host::io::recording::{self, ReadError};
 use gaitclip_host::io::trace::{Ranges, Trace};
 use gaitclip_host::io::units::{AccUnit, Front, GyroUnit, Units};
+use gaitclip_host::stream::StreamError;
 use gaitclip_host::{
     eval::length_eval, eval::matching, eval::tables, io::datasets, io::mcap_io, replay,
     sim::fixtures, train::codegen, train::fit, train::training, train::training_set,
@@ -542,7 +543,21 @@ fn run(cli: Cli) -> anyhow::Result<()> {
                 )
                 .into());
             }
-            let mut t = read_trace(&trace, rate, &units)?;
+            // A CSV recording is replayed as a stream, in constant memory
+            // (`gaitclip_host::stream`); an MCAP one, or one written back out, whole.
+            let streamed = !recording::is_mcap(&trace) && mcap_out.is_none();
+            let (mut t, stream) = if streamed {
+                let o = recording::ReadOptions {
+                    rate_hz: rate,
+                    rate_overrides_stamps: units.rate_overrides_stamps,
+                    units: units.units(&trace)?,
+                    front: Front::CommandLine,
+                };
+                let s = gaitclip_host::stream::Streamed::open(&trace, &o)?;
+                (Trace::default(), Some(s))
+            } else {
+                (read_trace(&trace, rate, &units)?, None)
+            };
             for (given, name) in [
                 (acc_range_g, "--acc-range-g"),
                 (gyro_range_dps, "--gyro-range-dps"),
@@ -555,12 +570,7 @@ fn run(cli: Cli) -> anyhow::Result<()> {
                     .into());
                 }
             }
-            t.given.acc_g = acc_range_g.or(t.given.acc_g);
-            t.given.gyro_dps = gyro_range_dps.or(t.given.gyro_dps);
-            let (strides, summary) =
-                replay::replay_summarised(&t, Ranges::default(), detector, model, all_models)
-                    .with_context(|| trace.display().to_string())?;
-            for s in &strides {
+            let show = |s: &replay::StrideReport| -> anyhow::Result<()> {
                 if json {
                     println!("{}", serde_json::to_string(s)?);
                 } else {
@@ -571,7 +581,45 @@ fn run(cli: Cli) -> anyhow::Result<()> {
                         println!("           {}", cols.join("  "));
                     }
                 }
-            }
+                Ok(())
+            };
+            let (strides, summary) = match stream {
+                Some(mut s) => {
+                    s.given.acc_g = acc_range_g.or(s.given.acc_g);
+                    s.given.gyro_dps = gyro_range_dps.or(s.given.gyro_dps);
+                    let mut failed = None;
+                    let (summary, _) = s
+                        .replay(Ranges::default(), detector, model, all_models, |r| {
+                            if failed.is_none() {
+                                failed = show(&r).err();
+                            }
+                        })
+                        // The causes the whole-recording replay would give, typed as its.
+                        .map_err(|e| match e {
+                            StreamError::Read(r) => anyhow::Error::from(r),
+                            StreamError::Replay(r) => anyhow::Error::from(r),
+                        })
+                        .with_context(|| trace.display().to_string())?;
+                    if let Some(e) = failed {
+                        return Err(e);
+                    }
+                    (Vec::new(), summary)
+                }
+                None => {
+                    t.given.acc_g = acc_range_g.or(t.given.acc_g);
+                    t.given.gyro_dps = gyro_range_dps.or(t.given.gyro_dps);
+                    let (strides, summary) = replay::replay_summarised(
+                        &t,
+                        Ranges::default(),
+                        detector,
+                        model,
+                        all_models,
+                    )
+                    .with_context(|| trace.display().to_string())?;
+                    strides.iter().try_for_each(show)?;
+                    (strides, summary)
+                }
+            };
             for m in &summary.rejected_movements {
                 if json {
                     println!(

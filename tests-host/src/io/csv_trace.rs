@@ -198,7 +198,7 @@ pub fn meta_units(csv: &Path) -> Result<Units, CsvError> {
 
 /// The nominal ranges `acc_range_g` and `gyro_range_dps` of a `meta.json` beside the file,
 /// where it gives them.
-fn meta_ranges(csv: &Path) -> Result<crate::io::trace::GivenRanges, CsvError> {
+pub(crate) fn meta_ranges(csv: &Path) -> Result<crate::io::trace::GivenRanges, CsvError> {
     let Some((meta, v)) = meta_json(csv)? else {
         return Ok(Default::default());
     };
@@ -209,7 +209,7 @@ fn meta_ranges(csv: &Path) -> Result<crate::io::trace::GivenRanges, CsvError> {
 }
 
 /// The `sample_rate_hz` of a `meta.json` beside the file, where it gives one.
-fn meta_rate(csv: &Path) -> Result<Option<f64>, CsvError> {
+pub(crate) fn meta_rate(csv: &Path) -> Result<Option<f64>, CsvError> {
     match meta_json(csv)? {
         None => Ok(None),
         Some((meta, v)) => positive(&meta, &v, "sample_rate_hz"),
@@ -248,10 +248,32 @@ impl Rows {
 }
 
 fn parse_rows(path: &Path, bytes: &[u8]) -> Result<Rows, CsvError> {
+    let mut out = Vec::new();
+    let mut lines = Vec::new();
+    let t_col = parse_each(path, bytes, |sample, line| {
+        lines.push(line);
+        out.push(sample);
+        Ok(())
+    })?;
+    Ok(Rows {
+        samples: out,
+        lines,
+        t_col,
+    })
+}
+
+/// Parses the CSV `reader` (the file `path`, for the errors) row by row, handing each sample
+/// and its 1-based line to `row` as it is read; returns the 1-based column of `t_s`. What
+/// [`parse`] and a recording read as a stream ([`crate::stream`]) both read with.
+pub fn parse_each(
+    path: &Path,
+    reader: impl std::io::Read,
+    mut row: impl FnMut(ImuSample, u64) -> Result<(), CsvError>,
+) -> Result<usize, CsvError> {
     let mut rdr = csv::ReaderBuilder::new()
         .has_headers(true)
         .trim(csv::Trim::All)
-        .from_reader(bytes);
+        .from_reader(reader);
     let malformed = |e: csv::Error| CsvError::Malformed {
         path: path.to_owned(),
         line: e.position().map_or(0, |p| p.line()),
@@ -269,9 +291,8 @@ fn parse_rows(path: &Path, bytes: &[u8]) -> Result<Rows, CsvError> {
                 header: header.iter().collect::<Vec<_>>().join(","),
             })?;
     }
-    let mut out = Vec::new();
-    let mut lines = Vec::new();
     let mut rec = csv::StringRecord::new();
+    let mut any = false;
     loop {
         match rdr.read_record(&mut rec) {
             Ok(false) => break,
@@ -294,23 +315,22 @@ fn parse_rows(path: &Path, bytes: &[u8]) -> Result<Rows, CsvError> {
                     text: text.to_owned(),
                 })?;
         }
-        lines.push(line);
-        out.push(ImuSample {
-            t_s: v[0],
-            acc_mps2: [v[1], v[2], v[3]],
-            gyr_radps: [v[4], v[5], v[6]],
-        });
+        any = true;
+        row(
+            ImuSample {
+                t_s: v[0],
+                acc_mps2: [v[1], v[2], v[3]],
+                gyr_radps: [v[4], v[5], v[6]],
+            },
+            line,
+        )?;
     }
-    if out.is_empty() {
+    if !any {
         return Err(CsvError::Empty {
             path: path.to_owned(),
         });
     }
-    Ok(Rows {
-        samples: out,
-        lines,
-        t_col: idx[0] + 1,
-    })
+    Ok(idx[0] + 1)
 }
 
 /// Writes a trace as CSV. Values are printed in Rust's shortest round-trip form, so reading

@@ -135,10 +135,14 @@ fn channel(s: &ImuSample, k: usize) -> f64 {
 /// from a flat run at the extreme, where the data shows one above [`MIN_SHARE_OF_RANGE`] of
 /// `nominal[k]` (> 0, the axis's unit). Two passes over the samples for all twelve sides: the
 /// extremes, then the runs at them.
-fn plateaus(samples: &[ImuSample], nominal: [f64; 6]) -> [[Option<f64>; 2]; 6] {
+fn plateaus<I: Iterator<Item = ImuSample>>(
+    samples: &impl Fn() -> I,
+    nominal: [f64; 6],
+) -> [[Option<f64>; 2]; 6] {
     const SIGNS: [f64; 2] = [-1.0, 1.0];
     let mut m = [[f64::NEG_INFINITY; 2]; 6];
-    for s in samples {
+    for s in samples() {
+        let s = &s;
         for (k, mk) in m.iter_mut().enumerate() {
             let v = channel(s, k);
             if v.is_finite() {
@@ -159,7 +163,8 @@ fn plateaus(samples: &[ImuSample], nominal: [f64; 6]) -> [[Option<f64>; 2]; 6] {
     });
     let mut counts = [[(0usize, 0usize, 0usize, 0usize); 2]; 6];
     if candidate.iter().flatten().any(|&c| c) {
-        for s in samples {
+        for s in samples() {
+            let s = &s;
             for k in 0..6 {
                 let x = channel(s, k);
                 for (side, sign) in SIGNS.iter().enumerate() {
@@ -206,6 +211,22 @@ pub fn learn(samples: &[ImuSample], ranges: Ranges, given: GivenRanges) -> Rails
 pub fn learn_counted(
     samples: &[ImuSample],
     counts: &[RawSample],
+    ranges: Ranges,
+    given: GivenRanges,
+) -> RailsReport {
+    learn_counted_of(
+        &|| samples.iter().copied(),
+        counts.iter().copied(),
+        ranges,
+        given,
+    )
+}
+
+/// [`learn_counted`] of the samples each call of `samples` yields in order (two passes) and
+/// their `counts` (one pass): a recording read as a stream, nothing kept per sample.
+pub fn learn_counted_of<I: Iterator<Item = ImuSample>>(
+    samples: &impl Fn() -> I,
+    counts: impl Iterator<Item = RawSample>,
     ranges: Ranges,
     given: GivenRanges,
 ) -> RailsReport {
@@ -263,7 +284,7 @@ pub fn learn_counted(
         });
     }
     for c in counts {
-        let bits = rails.clipped_axes(c);
+        let bits = rails.clipped_axes(&c);
         // Bits 0–2 accelerometer, 3–5 gyroscope: the same order as `AXES`.
         for (k, a) in axes.iter_mut().enumerate() {
             if bits & (1 << k) != 0 {

@@ -9,6 +9,7 @@
 //! ±4000 °/s. A unit that fails the check is refused with the unit the values look like and
 //! how to say so; nothing is rescaled behind the user's back.
 
+use crate::io::clock::nth_smallest;
 use std::fmt;
 
 use crate::io::trace::ImuSample;
@@ -307,10 +308,9 @@ fn norm(v: [f64; 3]) -> f64 {
     (v[0] * v[0] + v[1] * v[1] + v[2] * v[2]).sqrt()
 }
 
-/// The `q` quantile (0–1) of `v` (reordered; `v` not empty).
-fn quantile(v: &mut [f64], q: f64) -> f64 {
-    let at = ((v.len() as f64 * q) as usize).min(v.len() - 1);
-    *v.select_nth_unstable_by(at, f64::total_cmp).1
+/// The rank of the `q` quantile (0–1) of `n` values (`n` > 0): the index a sort puts it at.
+fn quantile_rank(n: usize, q: f64) -> usize {
+    ((n as f64 * q) as usize).min(n - 1)
 }
 
 /// Checks that samples converted from `declared` ([`Units::to_si`]) can be in those units:
@@ -318,14 +318,25 @@ fn quantile(v: &mut [f64], q: f64) -> f64 {
 /// percentile of |ω| under [`GYRO_MAX_RADPS`], and over [`GYRO_STEPPING_MIN_RADPS`] where
 /// the accelerometer shows steps. An empty recording passes (the readers refuse it).
 pub fn check(samples: &[ImuSample], declared: Units, front: Front) -> Result<(), UnitError> {
-    if samples.is_empty() {
+    check_of(&|| samples.iter().copied(), samples.len(), declared, front)
+}
+
+/// [`check`] of the `n` samples each call of `samples` yields in order (a recording read as
+/// a stream): the same arithmetic in the same order, the quantiles exact order statistics
+/// ([`crate::io::clock::nth_smallest`]), nothing kept per sample.
+pub fn check_of<I: Iterator<Item = ImuSample>>(
+    samples: &impl Fn() -> I,
+    n: usize,
+    declared: Units,
+    front: Front,
+) -> Result<(), UnitError> {
+    if n == 0 {
         return Ok(());
     }
-    let mut acc: Vec<f64> = samples.iter().map(|s| norm(s.acc_mps2)).collect();
-    let mean = acc.iter().sum::<f64>() / acc.len() as f64;
-    let spread =
-        (acc.iter().map(|a| (a - mean) * (a - mean)).sum::<f64>() / acc.len() as f64).sqrt();
-    let quartile = quantile(&mut acc, 0.25);
+    let acc = || samples().map(|s| norm(s.acc_mps2));
+    let mean = acc().sum::<f64>() / n as f64;
+    let spread = (acc().map(|a| (a - mean) * (a - mean)).sum::<f64>() / n as f64).sqrt();
+    let quartile = nth_smallest(&acc, quantile_rank(n, 0.25));
     let about_1g = |m: f64| m >= ACC_QUARTILE_MPS2.0 && m <= ACC_QUARTILE_MPS2.1;
     if !about_1g(quartile) {
         let raw = quartile / declared.acc.mps2();
@@ -338,8 +349,10 @@ pub fn check(samples: &[ImuSample], declared: Units, front: Front) -> Result<(),
             front,
         });
     }
-    let mut rate: Vec<f64> = samples.iter().map(|s| norm(s.gyr_radps)).collect();
-    let top = quantile(&mut rate, 0.999);
+    let top = nth_smallest(
+        &|| samples().map(|s| norm(s.gyr_radps)),
+        quantile_rank(n, 0.999),
+    );
     if top > GYRO_MAX_RADPS {
         return Err(UnitError::GyroTooFast {
             declared: declared.gyro,

@@ -1,0 +1,394 @@
+//! A CSV recording replayed in constant memory: a week at 100 Hz is 60 M samples, and
+//! holding it (≈ 160 bytes a sample in the replay that reads it whole) would take 10 GB.
+//!
+//! **How.** The file is parsed once, row by row, into a spool on disk (64 bytes a row: the
+//! stamp, the six values, the line for the errors; deleted when the replay ends). Every step
+//! that looks at the whole recording then reads the spool again from the start, in order,
+//! keeping only what it needs, and the last pass feeds the core and hands each stride out
+//! as the pipeline reports it. What each step keeps:
+//!
+//! | step | passes | kept |
+//! |---|---|---|
+//! | re-sent samples dropped ([`crate::io::clock::RepeatFilter`]) | every pass, on the fly | the last stamp |
+//! | the nominal rate from the stamps, where none is given ([`crate::io::clock::nominal_period_of`]) | 1 + 4 + 1 | 65 536 counters: the median is an exact radix select |
+//! | units ([`crate::io::units::check_of`]) | 2 + 4 + 4 | 65 536 counters (the quantiles the same way) |
+//! | clock: the period refined, holes found, fitted ([`crate::io::clock::SampleClock::recover_of`]) | 1–4 + 2 per round (≤ 6) + 1 | the holes (16 bytes each), at most 65 536 fit points (1 MiB: one per 64 rows, coarser past 4.19 M rows), a window of 64 rows |
+//! | holes placed in bursts ([`crate::io::clock::SampleClock::place_holes_of`]) | 1 | a window of 128 rows |
+//! | rails ([`crate::io::rails::learn_counted_of`]) | 3 | per axis and side a few numbers |
+//! | the core | 1 | the pipeline, the refused movements (a few per minute of not walking) |
+//!
+//! Every step runs the code the whole-recording replay runs ([`crate::replay`], the same
+//! functions over a slice), with the same arithmetic in the same order: the output is
+//! byte-identical (a test replays every shared CSV recording both ways, and recordings with
+//! every fault the readers handle or refuse). What grows with the recording is what it
+//! holds: its holes (16 bytes each; `ipol_gait_events`' lossy link loses 2 % of its packets in
+//! holes of 1–11) and the movements the step check refuses (a few per minute of not
+//! walking). A week at 100 Hz of walks (60 M samples) peaks at about 10 MiB
+//! (`tests-host/cost.sh`, docs/cost.md). An MCAP recording, or a replay that writes the
+//! samples back out (`--mcap-out`), is still read whole.
+
+use std::cell::RefCell;
+use std::fs::File;
+use std::io::{BufReader, BufWriter, Read, Write};
+use std::path::{Path, PathBuf};
+use std::sync::atomic::{AtomicU64, Ordering};
+
+use gaitclip::length::models::Model;
+use gaitclip::pipeline::config::Config;
+use gaitclip::pipeline::detectors::Detector;
+use gaitclip::sensor::rate::SampleRate;
+use gaitclip::sensor::sample::RangeScale;
+
+use crate::io::clock::{nominal_period_of, RepeatFilter, SampleClock};
+use crate::io::csv_trace::{self, CsvError};
+use crate::io::rails::{self, RailsReport};
+use crate::io::recording::{ReadError, ReadOptions, RATE_DISAGREES};
+use crate::io::trace::{GivenRanges, ImuSample, Ranges};
+use crate::io::units::{self, Front};
+use crate::replay::{self, Preparation, ReplayError, StrideReport, StrideTally, Summary};
+
+/// Bytes of a row in the spool: the stamp, six values and the line, eight bytes each.
+pub const ROW_BYTES: usize = 64;
+
+/// What a streamed replay can fail with: reading the recording, or preparing it.
+#[derive(Debug, thiserror::Error)]
+pub enum StreamError {
+    /// Reading (as [`crate::io::recording::read`] would fail).
+    #[error(transparent)]
+    Read(#[from] ReadError),
+    /// Preparing (as [`crate::replay::prepare`] would fail).
+    #[error(transparent)]
+    Replay(#[from] ReplayError),
+}
+
+/// A recording's rows on disk, to be read as often as needed; the file goes with it.
+pub struct Spool {
+    file: PathBuf,
+    rows: usize,
+    t_col: usize,
+    source: PathBuf,
+    /// A read of the spool that failed (the disk, not the recording): said at the end.
+    failed: RefCell<Option<std::io::Error>>,
+}
+
+/// A row of the spool.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct SpooledRow {
+    /// The sample as read (the file's units).
+    pub sample: ImuSample,
+    /// Its 1-based line in the file.
+    pub line: u64,
+}
+
+impl Spool {
+    /// Parses the CSV file `path` into a spool in the temporary folder
+    /// ([`std::env::temp_dir`]), with the errors [`csv_trace::read`] gives.
+    pub fn of_csv(path: &Path) -> Result<Spool, CsvError> {
+        static NEXT: AtomicU64 = AtomicU64::new(0);
+        let io = |source| CsvError::Io {
+            path: path.to_owned(),
+            source,
+        };
+        // A first read says what reading the whole file would (a folder: "Is a directory").
+        let mut input = BufReader::with_capacity(1 << 20, File::open(path).map_err(io)?);
+        std::io::BufRead::fill_buf(&mut input).map_err(io)?;
+        let file = std::env::temp_dir().join(format!(
+            "gaitclip-{}-{}.spool",
+            std::process::id(),
+            NEXT.fetch_add(1, Ordering::Relaxed)
+        ));
+        let mut spool = Spool {
+            file: file.clone(),
+            rows: 0,
+            t_col: 1,
+            source: path.to_owned(),
+            failed: RefCell::new(None),
+        };
+        let spool_io = |source| CsvError::Io {
+            path: file.clone(),
+            source,
+        };
+        let mut out = BufWriter::with_capacity(1 << 20, File::create(&file).map_err(spool_io)?);
+        let mut rows = 0usize;
+        spool.t_col = csv_trace::parse_each(path, input, |s, line| {
+            let mut b = [0u8; ROW_BYTES];
+            let v = [
+                s.t_s,
+                s.acc_mps2[0],
+                s.acc_mps2[1],
+                s.acc_mps2[2],
+                s.gyr_radps[0],
+                s.gyr_radps[1],
+                s.gyr_radps[2],
+            ];
+            for (k, x) in v.iter().enumerate() {
+                b[8 * k..8 * k + 8].copy_from_slice(&x.to_le_bytes());
+            }
+            b[56..].copy_from_slice(&line.to_le_bytes());
+            rows += 1;
+            out.write_all(&b).map_err(|source| CsvError::Io {
+                path: file.clone(),
+                source,
+            })
+        })?;
+        out.flush().map_err(spool_io)?;
+        spool.rows = rows;
+        Ok(spool)
+    }
+
+    /// Rows in the spool.
+    pub fn rows(&self) -> usize {
+        self.rows
+    }
+
+    /// The rows, in order, read again from the start.
+    pub fn read(&self) -> SpoolRows<'_> {
+        let reader = match File::open(&self.file) {
+            Ok(f) => Some(BufReader::with_capacity(1 << 20, f)),
+            Err(e) => {
+                self.failed.borrow_mut().get_or_insert(e);
+                None
+            }
+        };
+        SpoolRows {
+            spool: self,
+            reader,
+            left: self.rows,
+        }
+    }
+
+    /// The error a read of the spool met, if one did (as an error of the recording's file).
+    fn failure(&self) -> Option<CsvError> {
+        self.failed.borrow_mut().take().map(|source| CsvError::Io {
+            path: self.source.clone(),
+            source,
+        })
+    }
+}
+
+impl Drop for Spool {
+    fn drop(&mut self) {
+        let _ = std::fs::remove_file(&self.file);
+    }
+}
+
+/// The rows of a [`Spool`], in order.
+pub struct SpoolRows<'a> {
+    spool: &'a Spool,
+    reader: Option<BufReader<File>>,
+    left: usize,
+}
+
+impl Iterator for SpoolRows<'_> {
+    type Item = SpooledRow;
+
+    fn next(&mut self) -> Option<SpooledRow> {
+        if self.left == 0 {
+            return None;
+        }
+        let r = self.reader.as_mut()?;
+        let mut b = [0u8; ROW_BYTES];
+        if let Err(e) = r.read_exact(&mut b) {
+            self.spool.failed.borrow_mut().get_or_insert(e);
+            self.reader = None;
+            return None;
+        }
+        self.left -= 1;
+        let f = |k: usize| f64::from_le_bytes(b[8 * k..8 * k + 8].try_into().unwrap_or([0; 8]));
+        Some(SpooledRow {
+            sample: ImuSample {
+                t_s: f(0),
+                acc_mps2: [f(1), f(2), f(3)],
+                gyr_radps: [f(4), f(5), f(6)],
+            },
+            line: u64::from_le_bytes(b[56..].try_into().unwrap_or([0; 8])),
+        })
+    }
+}
+
+/// A CSV recording read as [`crate::io::recording::read`] reads it, kept on disk: its rows
+/// without the re-sent ones, in SI units, as often as needed ([`Streamed::samples`]).
+pub struct Streamed {
+    spool: Spool,
+    /// Re-sent samples are judged at this period.
+    repeat_period_s: f64,
+    /// Accelerometer and gyro values times these are SI.
+    to_si: (f64, f64),
+    /// Samples kept.
+    kept: usize,
+    /// Re-sent samples dropped.
+    repeated: usize,
+    /// The nominal rate, Hz (given, `meta.json`'s or the stamps').
+    pub rate_hz: f64,
+    /// The ranges the sensor was set to, where known.
+    pub given: GivenRanges,
+}
+
+impl Streamed {
+    /// Reads the CSV file `path` as `o` says, with [`crate::io::recording::read`]'s checks
+    /// and errors. Not for MCAP.
+    pub fn open(path: &Path, o: &ReadOptions) -> Result<Streamed, ReadError> {
+        let rate_given = match o.rate_hz {
+            Some(r) => Some(r),
+            None => csv_trace::meta_rate(path)?,
+        };
+        let declared = match o.units {
+            Some(u) => u,
+            None => csv_trace::meta_units(path)?,
+        };
+        let spool = Spool::of_csv(path)?;
+        // Re-sent samples: at the rate known, else at the stamps' (as `Trace::drop_repeats`).
+        let raw_stamps = || spool.read().map(|r| r.sample.t_s);
+        let repeat_period_s = match rate_given {
+            Some(r) if r > 0.0 => 1.0 / r,
+            _ => nominal_period_of(&raw_stamps, spool.rows()).unwrap_or(0.0),
+        };
+        let mut filter = RepeatFilter::new(repeat_period_s);
+        let mut kept = 0usize;
+        for (i, r) in spool.read().enumerate() {
+            match filter.keeps(i, r.sample.t_s) {
+                Ok(true) => kept += 1,
+                Ok(false) => {}
+                Err(e) => {
+                    return Err(CsvError::TimeGoesBack {
+                        path: path.to_owned(),
+                        line: r.line,
+                        col: spool.t_col,
+                        t_s: e.t_s,
+                        previous_s: e.previous_s,
+                    }
+                    .into())
+                }
+            }
+        }
+        let mut s = Streamed {
+            repeated: spool.rows() - kept,
+            spool,
+            repeat_period_s,
+            to_si: (declared.acc.mps2(), declared.gyro.radps()),
+            kept,
+            rate_hz: 0.0,
+            given: GivenRanges::default(),
+        };
+        if let Some(e) = s.spool.failure() {
+            return Err(e.into());
+        }
+        units::check_of(&|| s.samples(), s.kept, declared, o.front).map_err(|unit| {
+            CsvError::Units {
+                path: path.to_owned(),
+                unit,
+            }
+        })?;
+        let stamps_hz = |s: &Streamed| {
+            nominal_period_of(&|| s.samples().map(|x| x.t_s), s.kept).map(|p| 1.0 / p)
+        };
+        s.rate_hz = match rate_given {
+            Some(r) => r,
+            None => stamps_hz(&s).ok_or_else(|| CsvError::Empty {
+                path: path.to_owned(),
+            })?,
+        };
+        s.given = csv_trace::meta_ranges(path)?;
+        if let (Some(given_hz), false) = (o.rate_hz, o.rate_overrides_stamps) {
+            if let Some(stamps_hz) =
+                stamps_hz(&s).filter(|h| (given_hz / h - 1.0).abs() > RATE_DISAGREES)
+            {
+                return Err(ReadError::RateContradicts {
+                    path: path.to_owned(),
+                    given_hz,
+                    stamps_hz,
+                    how: match o.front {
+                        Front::CommandLine => "pass --rate-overrides-stamps",
+                        Front::Python => "pass rate_overrides_stamps=True",
+                    },
+                });
+            }
+        }
+        if let Some(e) = s.spool.failure() {
+            return Err(e.into());
+        }
+        Ok(s)
+    }
+
+    /// The samples kept (re-sent ones dropped), in SI units, in order, read again.
+    pub fn samples(&self) -> impl Iterator<Item = ImuSample> + '_ {
+        let mut filter = RepeatFilter::new(self.repeat_period_s);
+        let (ka, kg) = self.to_si;
+        self.spool
+            .read()
+            .enumerate()
+            .filter(move |(i, r)| filter.keeps(*i, r.sample.t_s).unwrap_or(false))
+            .map(move |(_, r)| {
+                let mut s = r.sample;
+                s.acc_mps2 = s.acc_mps2.map(|v| v * ka);
+                s.gyr_radps = s.gyr_radps.map(|v| v * kg);
+                s
+            })
+    }
+
+    /// Samples kept.
+    pub fn len(&self) -> usize {
+        self.kept
+    }
+
+    /// Whether none was (a spool always holds one at least).
+    pub fn is_empty(&self) -> bool {
+        self.kept == 0
+    }
+
+    /// Replays the recording through the core as [`crate::replay::replay_clocked`] does,
+    /// each stride handed to `stride` as the core reports it; the summary and the sample
+    /// clock at the end.
+    pub fn replay(
+        &self,
+        ranges: Ranges,
+        detector: Detector,
+        model: Model,
+        all_models: bool,
+        mut stride: impl FnMut(StrideReport),
+    ) -> Result<(Summary, SampleClock), StreamError> {
+        // `prepare`'s own pass over re-sent samples drops none: the kept stamps increase.
+        let n = self.kept;
+        let stamps = || self.samples().map(|s| s.t_s);
+        let mut clock =
+            SampleClock::recover_of(&stamps, n, Some(self.rate_hz)).ok_or(ReplayError::Empty)?;
+        let mhz = (clock.rate_hz() * 1000.0).round();
+        let rate = SampleRate::from_millihertz(mhz.clamp(0.0, u32::MAX as f64) as u32)
+            .ok_or(ReplayError::Rate(clock.rate_hz()))?;
+        let counts = || self.samples().map(move |s| ranges.to_counts(&s));
+        let rails: RailsReport =
+            rails::learn_counted_of(&|| self.samples(), counts(), ranges, self.given);
+        clock.place_holes_of(
+            self.samples()
+                .map(|s| (s.t_s, ranges.to_counts(&s).gyro.map(|v| v as f64))),
+        );
+        let mut config = Config::new(rate, ranges.accel.scale(), ranges.gyro.scale());
+        config.rails = rails.rails;
+        config.model = model;
+        config.detector = detector;
+        let mut tally = StrideTally::default();
+        let run = replay::core_run_each(counts(), &clock.holes, config, |s, stats| {
+            tally.add(&s);
+            let mut r = StrideReport {
+                stats,
+                ..replay::report(s, config, &|n| clock.t_s(n))
+            };
+            if all_models && detector != Detector::PeakValley {
+                replay::add_all_models(&mut r, config, rate);
+            }
+            stride(r);
+        });
+        if let Some(e) = self.spool.failure() {
+            return Err(ReadError::from(e).into());
+        }
+        let summary = Preparation {
+            read: (self.kept + self.repeated, self.repeated),
+            clock: &clock,
+            rails: &rails,
+            nominal_hz: self.rate_hz,
+            rate,
+        }
+        .summary(&run, &tally);
+        Ok((summary, clock))
+    }
+}
