@@ -31,6 +31,7 @@ use gaitclip::record::stride::{Stride, StrideFlags};
 use gaitclip::sensor::sample::{AccelRange, GyroRange, Rails, RawSample};
 
 use crate::eval::markdown::{cm_cell, Table};
+use crate::eval::stats::quantile_at_rounded_index;
 use crate::io::datasets;
 use crate::io::trace::{Ranges, Trace, G_MPS2};
 use crate::{io::csv_trace, replay};
@@ -387,19 +388,12 @@ pub fn sprint_table(root: &std::path::Path) -> Result<Table> {
                 r.strides.iter().filter_map(f).collect()
             };
             let climb = |k: usize| -> Vec<f64> {
-                let mut v: Vec<f64> = r
-                    .strides
+                r.strides
                     .iter()
                     .map(|s| [s.climb_m.0, s.climb_m.1][k].abs())
-                    .collect();
-                v.sort_by(f64::total_cmp);
-                v
+                    .collect()
             };
-            let q = |v: &[f64], p: f64| {
-                v.get(((v.len().max(1) - 1) as f64 * p).round() as usize)
-                    .copied()
-                    .unwrap_or(0.0)
-            };
+            let q = quantile_at_rounded_index;
             let (clipped, recorded) = (climb(0), climb(1));
             let over = |v: &[f64]| v.iter().filter(|&&x| x > 0.3).count();
             t.row([

@@ -22,7 +22,7 @@ use crate::eval::course::{circular_median, direction, Part, MEDIAN_MIN_M};
 use crate::eval::length_eval::SPEED_BINS;
 use crate::eval::markdown::{cm_cell, Table};
 use crate::eval::matching::{self, Detected, Scored};
-use crate::eval::stats::median;
+use crate::eval::stats::{median, quantile_at_rounded_index};
 use crate::io::datasets;
 use crate::io::trace::Ranges;
 use crate::{io::csv_trace, replay};
@@ -269,19 +269,13 @@ pub const CLIMB_BINS: [(f64, f64); 4] = [(0.0, 0.1), (0.1, 0.2), (0.2, 0.3), (0.
 
 /// `median / p95 (Vicon's median / p95)` of |climb|, m.
 fn climb_cell(b: &[&Instant]) -> String {
-    let mut ours: Vec<f64> = b.iter().map(|x| x.climb_m.abs()).collect();
-    let mut vicon: Vec<f64> = b
+    let ours: Vec<f64> = b.iter().map(|x| x.climb_m.abs()).collect();
+    let vicon: Vec<f64> = b
         .iter()
         .map(|x| x.vicon_climb_m.abs())
         .filter(|v| v.is_finite())
         .collect();
-    ours.sort_by(f64::total_cmp);
-    vicon.sort_by(f64::total_cmp);
-    let q = |v: &[f64], p: f64| {
-        v.get(((v.len().max(1) - 1) as f64 * p).round() as usize)
-            .copied()
-            .unwrap_or(f64::NAN)
-    };
+    let q = quantile_at_rounded_index;
     format!(
         "{:.2} / {:.2} m ({:.2} / {:.2})",
         q(&ours, 0.5),
