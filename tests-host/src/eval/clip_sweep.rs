@@ -30,8 +30,7 @@ use anyhow::Result;
 use gaitclip::record::stride::{Stride, StrideFlags};
 use gaitclip::sensor::sample::{AccelRange, GyroRange, Rails, RawSample};
 
-use crate::eval::markdown::{cm_cell, Table};
-use crate::eval::stats::quantile_at_rounded_index;
+use crate::eval::markdown::{cm_cell, median_p95_beside, Table};
 use crate::io::datasets;
 use crate::io::trace::{Ranges, Trace, G_MPS2};
 use crate::{io::csv_trace, replay};
@@ -393,7 +392,6 @@ pub fn sprint_table(root: &std::path::Path) -> Result<Table> {
                     .map(|s| [s.climb_m.0, s.climb_m.1][k].abs())
                     .collect()
             };
-            let q = quantile_at_rounded_index;
             let (clipped, recorded) = (climb(0), climb(1));
             let over = |v: &[f64]| v.iter().filter(|&&x| x > 0.3).count();
             t.row([
@@ -404,13 +402,7 @@ pub fn sprint_table(root: &std::path::Path) -> Result<Table> {
                 cm_cell(&pick(&|s| Some(s.left_m))),
                 cm_cell(&pick(&|s| Some(s.restored_m))),
                 cm_cell(&pick(&|s| s.estimate_m)),
-                format!(
-                    "{:.2} / {:.2} ({:.2} / {:.2})",
-                    q(&clipped, 0.5),
-                    q(&clipped, 0.95),
-                    q(&recorded, 0.5),
-                    q(&recorded, 0.95)
-                ),
+                median_p95_beside(&clipped, &recorded, ""),
                 format!("{} ({})", over(&clipped), over(&recorded)),
             ]);
         }

@@ -167,6 +167,19 @@ pub fn cm_cell(e: &[f64]) -> String {
     format!("{:.1} / {:+.1} ({})", s.rmse * 100.0, s.bias * 100.0, s.n)
 }
 
+/// `median / p95{unit} (median / p95)` of `ours` and, beside them in brackets, `theirs`
+/// (quantiles at the rounded index, [`crate::eval::stats::quantile_at_rounded_index`]).
+pub fn median_p95_beside(ours: &[f64], theirs: &[f64], unit: &str) -> String {
+    let q = crate::eval::stats::quantile_at_rounded_index;
+    format!(
+        "{:.2} / {:.2}{unit} ({:.2} / {:.2})",
+        q(ours, 0.5),
+        q(ours, 0.95),
+        q(theirs, 0.5),
+        q(theirs, 0.95)
+    )
+}
+
 /// `RMSE / bias ± 95 % cm (n)` of errors in m, or `–` without any.
 pub fn cm_ci_cell(e: &[f64]) -> String {
     if e.is_empty() {

@@ -20,9 +20,9 @@ use gaitclip::record::stride::StrideFlags;
 
 use crate::eval::course::{circular_median, direction, Part, MEDIAN_MIN_M};
 use crate::eval::length_eval::SPEED_BINS;
-use crate::eval::markdown::{cm_cell, Table};
+use crate::eval::markdown::{cm_cell, median_p95_beside, Table};
 use crate::eval::matching::{self, Detected, Scored};
-use crate::eval::stats::{median, quantile_at_rounded_index};
+use crate::eval::stats::median;
 use crate::io::datasets;
 use crate::io::trace::Ranges;
 use crate::{io::csv_trace, replay};
@@ -210,11 +210,7 @@ pub fn report(root: &std::path::Path) -> Result<String> {
             .collect();
         let errors: Vec<f64> = b.iter().map(|x| x.zupt_error_m).collect();
         c.row([
-            if hi.is_infinite() {
-                format!("> {lo} m")
-            } else {
-                format!("{lo}–{hi} m")
-            },
+            crate::eval::length_eval::bin_label((lo, hi), "m"),
             b.len().to_string(),
             cm_cell(&errors),
             format!(
@@ -275,12 +271,5 @@ fn climb_cell(b: &[&Instant]) -> String {
         .map(|x| x.vicon_climb_m.abs())
         .filter(|v| v.is_finite())
         .collect();
-    let q = quantile_at_rounded_index;
-    format!(
-        "{:.2} / {:.2} m ({:.2} / {:.2})",
-        q(&ours, 0.5),
-        q(&ours, 0.95),
-        q(&vicon, 0.5),
-        q(&vicon, 0.95)
-    )
+    median_p95_beside(&ours, &vicon, " m")
 }
