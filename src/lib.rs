@@ -1,6 +1,6 @@
 //! # gaitclip — stride lengths from a shoe-clip IMU, in fixed point
 //!
-//! gaitclip turns the raw samples of an MPU6050 clipped to a shoe into one record per
+//! gaitclip turns the raw samples of an IMU clipped to a shoe into one record per
 //! stride: when it started, when the heel left the ground, when the toe left it, when the
 //! heel struck, when the foot was flat again, and how long the stride was.
 //!
@@ -10,9 +10,10 @@
 //! through a fixed chain of stages, in this order, each fed only the records of the stage
 //! before it:
 //!
-//! 1. [`mpu6050`] — the driver, its own crate (`drivers/mpu6050`, [`gaitclip_mpu6050`]): one
-//!    burst read per sample into a [`sensor::sample::RawSample`]
-//!    of counts. Nothing later looks at a register.
+//! 1. the driver — a crate of its own per part (`drivers/mpu6050`, …), which turns its
+//!    registers or FIFO words into the sensor seam's records ([`gaitclip_imu`]): a
+//!    [`sensor::sample::RawSample`] of counts and the scales they are in. Nothing later looks
+//!    at a register or knows the part.
 //! 2. [`signal::mean_filter`] — a moving average over a power-of-two ring with a running sum.
 //! 3. [`detect::foot_frame`] — which way is up (gravity in the rests that the orientation-free
 //!    [`detect::rest`] test finds) and which way is forward (the axis the foot pitches about in its
@@ -91,9 +92,10 @@
 //! | [`gait`] | the gait parameters of a stride |
 //! | [`pipeline`] | the configuration, the detector list, and the composition of it all |
 //!
-//! The driver, [`mpu6050`], is a crate of its own that knows nothing of gaitclip: the core
-//! depends on it only for its records (the sample, the ranges), which [`sensor::sample`]
-//! re-exports; no stage calls it, the boards do.
+//! The core does not know which sensor it has. It depends only on the seam, [`gaitclip_imu`]
+//! (the sample in counts, the accelerometer's and gyroscope's scales), which
+//! [`sensor::sample`] and [`sensor::units`] re-export; each driver crate provides those
+//! records, and no stage calls a driver: the boards do.
 //!
 //! ## Units
 //!
@@ -109,8 +111,6 @@ pub mod detect;
 pub mod fixed;
 pub mod gait;
 pub mod length;
-/// The driver, its own crate ([`gaitclip_mpu6050`]), under the name the chain's table uses.
-pub use gaitclip_mpu6050 as mpu6050;
 pub mod pipeline;
 pub mod record;
 pub mod sensor;

@@ -36,9 +36,8 @@ use gaitclip::pipeline::detectors::Detector;
 use gaitclip::pipeline::Pipeline;
 use gaitclip::record::stride::Stride;
 use gaitclip::sensor::rate::SampleRate;
-use gaitclip::sensor::sample::{AccelRange, GyroRange, RawSample, SAMPLE_BYTES};
-use gaitclip::sensor::units::{AccelScale, GyroScale};
 use gaitclip_board::Steps;
+use gaitclip_mpu6050::{AccelRange, GyroRange, SAMPLE_BYTES};
 use static_cell::ConstStaticCell;
 
 /// The movement buffer of the firmware on the same board (see `boards/microbit/main.rs`).
@@ -59,8 +58,8 @@ const RATE: SampleRate = unwrap(SampleRate::from_millihertz(trace::RATE_MILLIHER
 const CONFIG: Config = {
     let mut c = Config::new(
         RATE,
-        AccelScale::of(unwrap(AccelRange::from_afs_sel(trace::ACCEL_AFS_SEL))),
-        GyroScale::of(unwrap(GyroRange::from_fs_sel(trace::GYRO_FS_SEL))),
+        unwrap(AccelRange::from_afs_sel(trace::ACCEL_AFS_SEL)).scale(),
+        unwrap(GyroRange::from_fs_sel(trace::GYRO_FS_SEL)).scale(),
     );
     c.detector = gaitclip_board::DETECTOR;
     c
@@ -162,7 +161,7 @@ const fn registers(motion: &[u8; trace::MOTION_BYTES]) -> [u8; SAMPLE_BYTES] {
 /// One sample through the per-sample path: decoding its registers and the pipeline.
 #[inline(never)]
 fn bench_sample(pipeline: &mut BenchPipeline, regs: &[u8; SAMPLE_BYTES]) -> Option<Stride> {
-    let s = RawSample::from_be_bytes(regs);
+    let s = gaitclip_mpu6050::sample::from_be_bytes(regs);
     // black_box keeps the call a `bl` with a return (no tail call) for the counter to see.
     black_box(pipeline.process(&s))
 }

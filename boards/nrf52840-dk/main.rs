@@ -30,10 +30,10 @@ use cortex_m::interrupt::{self as irq, Mutex};
 use cortex_m_rt::entry;
 use defmt_rtt as _;
 use embedded_hal::i2c::{ErrorType, I2c, Operation, SevenBitAddress};
-use gaitclip::mpu6050::blocking::Mpu6050;
-use gaitclip::mpu6050::Address;
 use gaitclip::pipeline::Pipeline;
 use gaitclip_board::live_settings::MOVEMENT_SAMPLES;
+use gaitclip_mpu6050::blocking::Mpu6050;
+use gaitclip_mpu6050::Address;
 use heapless::spsc::Queue;
 use nrf52840_hal::{
     self as hal,

@@ -29,10 +29,10 @@ use cortex_m::interrupt::{self as irq, Mutex};
 use defmt_rtt as _;
 use embedded_hal::i2c::{ErrorType, I2c, Operation, SevenBitAddress};
 use fugit::{HertzU32, RateExtU32};
-use gaitclip::mpu6050::blocking::Mpu6050;
-use gaitclip::mpu6050::Address;
 use gaitclip::pipeline::Pipeline;
 use gaitclip_board::live_settings::MOVEMENT_SAMPLES;
+use gaitclip_mpu6050::blocking::Mpu6050;
+use gaitclip_mpu6050::Address;
 use heapless::spsc::Queue;
 use panic_probe as _;
 use rp2040_hal::{

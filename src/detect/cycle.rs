@@ -178,13 +178,15 @@ impl CycleConfig {
         if half as usize > (ENERGY_CAPACITY - 1) / 2 {
             half = ((ENERGY_CAPACITY - 1) / 2) as u32;
         }
-        // (rad/s per count)² = (π·10 / (180·lsb10))²; ÷ σω²; × 2⁴⁰.
-        let lsb10 = gyro.lsb_per_dps_x10() as u128;
+        // (rad/s per count)² = (π·dps / (180·lsb))²; ÷ σω²; × 2⁴⁰ (the scale is lsb counts per
+        // dps °/s).
+        let (lsb, dps) = (gyro.lsb() as u128, gyro.dps() as u128);
         let pi_q32 = 13_493_037_705u128;
         let sw = SIGMA_W_MRADPS as u128;
-        // π²·100·10⁶ / (180²·lsb10²·σω²[mrad²]) · 2⁴⁰ = (π·2³²)²·100·10⁶·2⁴⁰ / (2⁶⁴·180²·lsb10²·σ²)
+        // π²·dps²·10⁶ / (180²·lsb²·σω²[mrad²]) · 2⁴⁰ = (π·2³²)²·dps²·10⁶·2⁴⁰ / (2⁶⁴·180²·lsb²·σ²):
+        // below 2¹²⁸ for dps up to 10³ (π²·2⁶⁴ < 2⁶⁸, 10⁶·10⁶ < 2⁴⁰).
         let k_w =
-            ((pi_q32 * pi_q32 * 100 * 1_000_000) / (180 * 180 * lsb10 * lsb10 * sw * sw)) >> 24;
+            ((pi_q32 * pi_q32 * dps * dps * 1_000_000) / (180 * 180 * lsb * lsb * sw * sw)) >> 24;
         // (m/s² per count)² = (9.80665 / lsb_g)²; ÷ σa²; × 2⁴⁰.
         let lsb_g = accel.lsb_per_g() as u128;
         let sa = SIGMA_A_MMPS2 as u128;

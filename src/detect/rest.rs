@@ -49,8 +49,9 @@ impl RestThresholds {
         };
         // m/s² → counts: · lsb_per_g / 9.80665.
         let a = ACCEL_STD_MAX_MMPS2 as i64 * accel.lsb_per_g() as i64 / 9807;
-        // rad/s → counts: · (180/π) · lsb_per_dps (lsb10 / 10); 18/(π·1000) = 1800/314159.
-        let g = GYRO_RMS_MAX_MRADPS as i64 * gyro.lsb_per_dps_x10() as i64 * 1800 / 314_159;
+        // rad/s → counts: · (180/π) · lsb/dps; 180/(π·1000) = 18 000/314 159 per 10 °/s.
+        let g =
+            GYRO_RMS_MAX_MRADPS as i64 * gyro.lsb() as i64 * 18_000 / (314_159 * gyro.dps() as i64);
         RestThresholds {
             window,
             accel_var_counts2: a * a,

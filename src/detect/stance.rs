@@ -131,7 +131,9 @@ impl StanceThresholds {
         let num = FOOT_LSB_PER_G as i64 * (1 << DEFLATE_SHIFT) * 100;
         let std = limits.std_milli as i64 * num / 9_617_038;
         let iqr = limits.iqr_milli as i64 * num / 9_617_038;
-        let g = limits.gyro_mradps as i64 * gyro.lsb_per_dps_x10() as i64 * 1800 / 314_159;
+        // rad/s → counts: · (180/π) · lsb/dps; 180/(π·1000) = 18 000/314 159 per 10 °/s.
+        let g =
+            limits.gyro_mradps as i64 * gyro.lsb() as i64 * 18_000 / (314_159 * gyro.dps() as i64);
         StanceThresholds {
             half,
             variance: std * std,
@@ -321,7 +323,7 @@ mod tests {
         let rate = SampleRate::from_hz(200).unwrap();
         StanceDetector::new(StanceThresholds::new(
             rate,
-            crate::sensor::units::GyroScale::of(crate::sensor::sample::GyroRange::Dps2000),
+            crate::sensor::units::GyroScale::from_lsb_per_dps_x10(164),
         ))
     }
 
@@ -342,7 +344,7 @@ mod tests {
     fn windows_are_centred_and_the_answer_waits_for_the_largest() {
         let t = StanceThresholds::new(
             SampleRate::from_hz(200).unwrap(),
-            crate::sensor::units::GyroScale::of(crate::sensor::sample::GyroRange::Dps2000),
+            crate::sensor::units::GyroScale::from_lsb_per_dps_x10(164),
         );
         assert_eq!(t.half, [3, 6, 12]);
         assert_eq!(t.delay(), 12);

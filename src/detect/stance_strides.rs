@@ -684,8 +684,8 @@ mod tests {
         let rate = SampleRate::from_hz(RATE_HZ).unwrap();
         StrideTracker::sized(
             rate,
-            crate::sensor::units::AccelScale::of(crate::sensor::sample::AccelRange::G16),
-            crate::sensor::units::GyroScale::of(crate::sensor::sample::GyroRange::Dps2000),
+            crate::sensor::units::AccelScale::from_lsb_per_g(2048),
+            crate::sensor::units::GyroScale::from_lsb_per_dps_x10(164),
             PhaseMethod::Augmented,
         )
     }

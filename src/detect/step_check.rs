@@ -368,8 +368,8 @@ pub struct StepLedger {
     band: i32,
     /// Counts·samples per degree of rotation at the rate and scale.
     per_deg: u32,
-    /// Gyro counts per °/s, × 10.
-    lsb10: u32,
+    /// The gyroscope's scale.
+    gyro: GyroScale,
     /// Samples of [`REST_NEAR_MS`].
     near: u32,
     /// Samples of [`REST_BLIP_MS`].
@@ -396,8 +396,9 @@ pub struct StepLedger {
 impl StepLedger {
     /// A ledger for samples at `rate` with gyro counts of `gyro`.
     pub const fn new(rate: SampleRate, gyro: GyroScale) -> Self {
-        // degrees × (lsb10/10 counts per °/s) × (rate samples per s): counts·samples.
-        let per_deg = (gyro.lsb_per_dps_x10() as u64 * rate.millihertz() as u64 / 10_000) as u32;
+        // degrees × (lsb/dps counts per °/s) × (rate samples per s): counts·samples.
+        let per_deg =
+            (gyro.lsb() as u64 * rate.millihertz() as u64 / (1_000 * gyro.dps() as u64)) as u32;
         let band = gyro.counts_of_mrad_per_s(500) as i32;
         StepLedger {
             rests: [RestRun {
@@ -422,11 +423,7 @@ impl StepLedger {
             lobe_negative: [false; 2],
             band: if band < 1 { 1 } else { band },
             per_deg: if per_deg < 1 { 1 } else { per_deg },
-            lsb10: if gyro.lsb_per_dps_x10() < 1 {
-                1
-            } else {
-                gyro.lsb_per_dps_x10()
-            },
+            gyro,
             near: rate.samples_in_ms(REST_NEAR_MS),
             blip: rate.samples_in_ms(REST_BLIP_MS),
             step_max: rate.samples_in_ms(STEP_MAX_MS),
@@ -571,8 +568,9 @@ impl StepLedger {
             rest_before |= Self::overlap(r.first, r.end, before.0, before.1);
             rest_after |= Self::overlap(r.first, r.end, after.0, after.1);
         }
-        // counts → mrad/s: · (10/lsb10) °/s · (π/180) · 1000 = · 174.533/lsb10.
-        let peak_mradps = (peak as u64 * 174_533 / (self.lsb10 as u64 * 1000)) as u32;
+        // counts → mrad/s: · (dps/lsb) °/s · (π/180) · 1000 = · 17.4533·dps/lsb.
+        let peak_mradps = (peak as u64 * 174_533 * self.gyro.dps() as u64
+            / (self.gyro.lsb() as u64 * 10_000)) as u32;
         // What the foot did since its last step (or since the last movement refused for
         // want of a stance, so that a walk out of pedalling loses one stride, not all).
         let last = self.last_end.unwrap_or(0);

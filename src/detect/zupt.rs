@@ -53,10 +53,10 @@ impl RollingContact {
     /// For a sensor `height_um` above the contact, at `rate` with gyro range `gyro`.
     /// Range: heights up to 1 m, any supported rate.
     pub const fn new(height_um: u32, rate: SampleRate, gyro: GyroScale) -> Self {
-        // v_q8 = ω_counts · (π/180)/lsb · h · unit_q8 · rate / g, with ω·(π/180)/lsb in
-        // rad/s: π·10·h_um·rate_mHz / (180·lsb10·1e6·1e3·9.80665) per (count · count·2⁸).
-        let num = PI_Q32 * 10 * height_um as u128 * rate.millihertz() as u128;
-        let den = 180 * gyro.lsb_per_dps_x10() as u128 * 9_806_650_000u128;
+        // v_q8 = ω_counts · (π/180)·(dps/lsb) · h · unit_q8 · rate / g, with ω·(π/180)·dps/lsb
+        // in rad/s: π·dps·h_um·rate_mHz / (180·lsb·1e6·1e3·9.80665) per (count · count·2⁸).
+        let num = PI_Q32 * gyro.dps() as u128 * height_um as u128 * rate.millihertz() as u128;
+        let den = 180 * gyro.lsb() as u128 * 9_806_650_000u128;
         // num / den · 2⁴⁰ = num · 2⁸ / den (num carries 2³²).
         let f = (num << 8) / den;
         RollingContact {
@@ -204,9 +204,9 @@ impl ZuptIntegrator {
         gyro: GyroScale,
         reading: GravityReading,
     ) -> Self {
-        // rad per count / (2 · rate) · 2⁴⁶ = π·10⁴·2⁴⁶ / (360 · lsb10 · rate_mHz).
-        let num = PI_Q32 * (1 << 14) * 10_000;
-        let den = 360 * gyro.lsb_per_dps_x10() as u128 * rate.millihertz() as u128;
+        // rad per count / (2 · rate) · 2⁴⁶ = π·dps·10³·2⁴⁶ / (360 · lsb · rate_mHz).
+        let num = PI_Q32 * (1 << 14) * 1_000 * gyro.dps() as u128;
+        let den = 360 * gyro.lsb() as u128 * rate.millihertz() as u128;
         ZuptIntegrator {
             half_angle_per_count_q46: ((num + den / 2) / den) as i64,
             rate,

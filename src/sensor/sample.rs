@@ -1,37 +1,12 @@
-//! One raw MPU6050 sample as it comes off the bus and the sensor's full-scale ranges (the
-//! driver's records, [`gaitclip_mpu6050`]), the scale each range's counts are in for the stages
-//! ([`RangeScale`]), and where a reading clips ([`Rails`]).
+//! One raw sample as the sensor seam hands it over ([`gaitclip_imu::RawSample`], whichever
+//! part read it), and where a reading clips ([`Rails`]).
 
-pub use gaitclip_mpu6050::{AccelRange, GyroRange, RawSample, SAMPLE_BYTES};
-
-use crate::sensor::units::{AccelScale, GyroScale};
-
-/// The scale a range's counts are in, as the stages compute in it.
-pub trait RangeScale {
-    /// [`AccelScale`] or [`GyroScale`].
-    type Scale;
-    /// The scale of this range's counts.
-    fn scale(self) -> Self::Scale;
-}
-
-impl RangeScale for AccelRange {
-    type Scale = AccelScale;
-    fn scale(self) -> AccelScale {
-        AccelScale::of(self)
-    }
-}
-
-impl RangeScale for GyroRange {
-    type Scale = GyroScale;
-    fn scale(self) -> GyroScale {
-        GyroScale::of(self)
-    }
-}
+pub use gaitclip_imu::RawSample;
 
 /// Where one axis clips, in counts: a reading at or beyond `low` or `high` sits at a rail
 /// and the true value may lie beyond it.
 ///
-/// The MPU6050's registers saturate at the counts' extremes ([`AxisRails::FULL_SCALE`]), but
+/// A part's output registers saturate at the counts' extremes ([`AxisRails::FULL_SCALE`]), but
 /// real parts clip below their nominal range (a ±16 g accelerometer axis at −15.6 g, a
 /// ±2000 °/s gyro at ±1 988 °/s), so a replayed recording's rails are learnt from its data
 /// or given, axis by axis, and the core is told them ([`Rails`]), never assumes them.
@@ -44,7 +19,7 @@ pub struct AxisRails {
 }
 
 impl AxisRails {
-    /// The counts' own extremes: what the MPU6050's output registers saturate at.
+    /// The counts' own extremes: what a part's output registers saturate at.
     pub const FULL_SCALE: AxisRails = AxisRails {
         low: i16::MIN,
         high: i16::MAX,
@@ -96,7 +71,7 @@ pub struct Rails {
 }
 
 impl Rails {
-    /// Every axis at the counts' extremes: the MPU6050 as the firmware reads it.
+    /// Every axis at the counts' extremes: a part as the firmware reads it.
     pub const FULL_SCALE: Rails = Rails {
         accel: [AxisRails::FULL_SCALE; 3],
         gyro: [AxisRails::FULL_SCALE; 3],

@@ -1,78 +1,13 @@
 //! Units the stages compute in, as types: a sensor's scale (counts per g, per °/s) apart
 //! from the register values that set it, and the foot-frame acceleration every stage after
-//! the foot frame reads. The stages take these, not the MPU6050's range enums
-//! ([`AccelScale::of`], [`GyroScale::of`] and [`crate::sensor::sample::RangeScale`] convert),
-//! so another sensor needs only its own scale.
+//! the foot frame reads. The scales are the sensor seam's records ([`gaitclip_imu`]): each
+//! driver says what its configuration's counts are in, and the stages take only that.
 
-use gaitclip_mpu6050::{AccelRange, GyroRange};
+pub use gaitclip_imu::{AccelScale, GyroScale};
 
 /// Foot-frame accelerations are in units of g/`FOOT_LSB_PER_G` whatever the sensor's range:
 /// 2048 counts per g, the MPU6050's ±16 g scale, so that ±16 g fits an `i16`.
 pub const FOOT_LSB_PER_G: i32 = 2048;
-
-/// An accelerometer's scale: counts per g.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub struct AccelScale {
-    lsb_per_g: u32,
-}
-
-impl AccelScale {
-    /// A scale of `lsb_per_g` counts per g (≥ 1).
-    pub const fn from_lsb_per_g(lsb_per_g: u32) -> Self {
-        AccelScale {
-            lsb_per_g: if lsb_per_g == 0 { 1 } else { lsb_per_g },
-        }
-    }
-
-    /// The scale of an MPU6050 range (its datasheet sensitivity).
-    pub const fn of(range: AccelRange) -> Self {
-        Self::from_lsb_per_g(range.lsb_per_g())
-    }
-
-    /// Counts per g.
-    pub const fn lsb_per_g(self) -> u32 {
-        self.lsb_per_g
-    }
-}
-
-/// A gyroscope's scale: counts per °/s, times ten so that the MPU6050's 131 and 16.4 are
-/// integers.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub struct GyroScale {
-    lsb_per_dps_x10: u32,
-}
-
-impl GyroScale {
-    /// A scale of `lsb_per_dps_x10` / 10 counts per °/s (≥ 1).
-    pub const fn from_lsb_per_dps_x10(lsb_per_dps_x10: u32) -> Self {
-        GyroScale {
-            lsb_per_dps_x10: if lsb_per_dps_x10 == 0 {
-                1
-            } else {
-                lsb_per_dps_x10
-            },
-        }
-    }
-
-    /// The scale of an MPU6050 range (its datasheet sensitivity).
-    pub const fn of(range: GyroRange) -> Self {
-        Self::from_lsb_per_dps_x10(range.lsb_per_dps_x10())
-    }
-
-    /// Counts per (°/s), times ten.
-    pub const fn lsb_per_dps_x10(self) -> u32 {
-        self.lsb_per_dps_x10
-    }
-
-    /// An angular rate in mrad/s as counts of this scale, rounded (exact to ±0.5 count plus
-    /// 1 ppm for π; any `mrad_per_s` up to 10⁶, 1 000 rad/s, and scales up to 10⁵).
-    pub const fn counts_of_mrad_per_s(self, mrad_per_s: u32) -> u32 {
-        // counts = mrad/1000 · (180/π) · lsb10/10, π as 3 141 593 / 10⁶.
-        let num = mrad_per_s as u64 * self.lsb_per_dps_x10 as u64 * 180 * 1_000_000;
-        let den = 3_141_593u64 * 10_000;
-        ((num + den / 2) / den) as u32
-    }
-}
 
 /// Mean-filtered acceleration in the foot frame, `[forward, left, up − g]`, in g /
 /// [`FOOT_LSB_PER_G`] (2048 counts per g, whatever the sensor's range): what the foot frame

@@ -2,7 +2,6 @@
 //! command replays their seed corpus and every crash ever found (`tests/fuzz_corpus.rs`)
 //! through exactly the code the fuzzer ran. Each one panics when an invariant breaks.
 
-use gaitclip::sensor::sample::RangeScale;
 use std::path::Path;
 
 use gaitclip::length::estimate::MAX_CYCLES;
@@ -12,7 +11,8 @@ use gaitclip::pipeline::detectors::Detector;
 use gaitclip::pipeline::Pipeline;
 use gaitclip::record::stride::{StrideFlags, MAX_STRIDE_MM};
 use gaitclip::sensor::rate::SampleRate;
-use gaitclip::sensor::sample::{AccelRange, GyroRange, RawSample};
+use gaitclip::sensor::sample::RawSample;
+use gaitclip_mpu6050::{AccelRange, GyroRange};
 
 use crate::io::trace::{Ranges, Trace};
 use crate::replay::{replay, StrideReport};

@@ -1,7 +1,6 @@
 //! Runs a trace through the firmware core, exactly as the board does, and reports strides
 //! in the trace's own clock.
 
-use gaitclip::sensor::sample::RangeScale;
 use std::collections::BTreeMap;
 
 use gaitclip::detect::phase_stats::StrideStats;

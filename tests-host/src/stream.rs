@@ -37,7 +37,6 @@ use gaitclip::length::models::Model;
 use gaitclip::pipeline::config::Config;
 use gaitclip::pipeline::detectors::Detector;
 use gaitclip::sensor::rate::SampleRate;
-use gaitclip::sensor::sample::RangeScale;
 
 use crate::io::clock::{nominal_period_of, RepeatFilter, SampleClock};
 use crate::io::csv_trace::{self, CsvError};

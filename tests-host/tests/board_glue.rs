@@ -3,13 +3,13 @@
 
 use embedded_hal::i2c::{ErrorType, I2c, Operation};
 use embedded_hal_mock::eh1::delay::NoopDelay;
-use gaitclip::mpu6050::blocking::Mpu6050;
-use gaitclip::mpu6050::{Address, Config, OutputRate};
 use gaitclip::pipeline::Pipeline;
 use gaitclip::sensor::rate::SampleRate;
-use gaitclip::sensor::sample::RangeScale;
-use gaitclip::sensor::sample::{AccelRange, GyroRange, RawSample};
+use gaitclip::sensor::sample::RawSample;
 use gaitclip_board::{imu_sampler, replay_mpu6050, serial_line, startup};
+use gaitclip_mpu6050::blocking::Mpu6050;
+use gaitclip_mpu6050::{AccelRange, GyroRange};
+use gaitclip_mpu6050::{Address, Config, OutputRate};
 use imu_sampler::{BusRecovery, Counters, ImuSampler, Item, ReadMode};
 use replay_mpu6050::{ReplayBusError, ReplayMpu6050};
 
@@ -99,7 +99,9 @@ fn a_failed_read_is_retried_and_nothing_is_lost() {
     let got = samples(&items);
     let bytes = trace();
     let want: Vec<RawSample> = (0..50)
-        .map(|n| RawSample::from_be_bytes(bytes[n * 14..n * 14 + 14].try_into().unwrap()))
+        .map(|n| {
+            gaitclip_mpu6050::sample::from_be_bytes(bytes[n * 14..n * 14 + 14].try_into().unwrap())
+        })
         .collect();
     assert_eq!(got, want);
 }

@@ -12,14 +12,13 @@
 use embedded_hal::i2c::{ErrorKind, ErrorType, I2c, NoAcknowledgeSource, Operation};
 use embedded_hal_mock::eh1::delay::NoopDelay;
 use embedded_hal_mock::eh1::i2c::{Mock, Transaction as T};
-use gaitclip::mpu6050::blocking::Mpu6050;
-use gaitclip::mpu6050::{Address, Config, OutputRate};
 use gaitclip::pipeline::Pipeline;
 use gaitclip::record::stride::{Stride, StrideFlags};
 use gaitclip::sensor::rate::SampleRate;
-use gaitclip::sensor::sample::RangeScale;
-use gaitclip::sensor::sample::{AccelRange, GyroRange};
 use gaitclip_board::imu_sampler::{self, asynch};
+use gaitclip_mpu6050::blocking::Mpu6050;
+use gaitclip_mpu6050::{AccelRange, GyroRange};
+use gaitclip_mpu6050::{Address, Config, OutputRate};
 use imu_sampler::{BusRecovery, Counters, ImuSampler, Item, ReadMode, RESTART_AFTER, RETRIES};
 
 // Register map (MPU-6000/6050 Register Map rev. 4.2), not imported from the driver.
@@ -187,7 +186,7 @@ impl Sampler {
                     .ok()
             }
             Flavor::Async => futures_executor::block_on(asynch::ImuSampler::start(
-                gaitclip::mpu6050::asynch::Mpu6050::new(bus, Address::Ad0Low),
+                gaitclip_mpu6050::asynch::Mpu6050::new(bus, Address::Ad0Low),
                 NoopDelay,
                 config,
                 mode,
@@ -452,12 +451,12 @@ fn a_fifo_overflow_becomes_a_gap_of_what_it_cost() {
         );
         let want: Vec<Item> = t[0..4]
             .iter()
-            .map(|x| Item::Sample(gaitclip::sensor::sample::RawSample::from_be_bytes(x)))
+            .map(|x| Item::Sample(gaitclip_mpu6050::sample::from_be_bytes(x)))
             .chain([Item::Gap(4)])
             .chain(
                 t[8..12]
                     .iter()
-                    .map(|x| Item::Sample(gaitclip::sensor::sample::RawSample::from_be_bytes(x))),
+                    .map(|x| Item::Sample(gaitclip_mpu6050::sample::from_be_bytes(x))),
             )
             .collect();
         assert_eq!(items, want);

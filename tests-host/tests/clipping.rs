@@ -2,13 +2,14 @@
 //! clipped on purpose (`gaitclip clipping`), and the rails learnt from the data
 //! ([`gaitclip_host::io::rails`]). Bounds just above the figures measured on 2026-12-03.
 
-use gaitclip::sensor::sample::{AccelRange, AxisRails, Rails};
+use gaitclip::sensor::sample::{AxisRails, Rails};
 use gaitclip_host::eval::clip_sweep::{sweep, CLIPPINGS};
 use gaitclip_host::eval::markdown::ErrorStats;
 use gaitclip_host::io::datasets::{self, root_or_skip};
 use gaitclip_host::io::rails::{learn, RailSource};
 use gaitclip_host::io::trace::GivenRanges;
 use gaitclip_host::io::trace::{ImuSample, Ranges, G_MPS2};
+use gaitclip_mpu6050::AccelRange;
 
 #[test]
 fn clipped_strides_are_put_back_within_2_cm_at_8_g_and_nearer_at_4_g() {

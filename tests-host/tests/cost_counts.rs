@@ -5,7 +5,6 @@
 
 use gaitclip::pipeline::config::Config;
 use gaitclip::pipeline::detectors::Detector;
-use gaitclip::sensor::sample::RangeScale;
 use gaitclip_host::cost::firmware::{self, repo_root};
 use gaitclip_host::cost::insn_count;
 use gaitclip_host::cost::qemu;
@@ -153,8 +152,8 @@ fn bench_runs_to_the_end_on_m0_with_each_detector() {
 fn demo_config() -> Config {
     Config::new(
         gaitclip::sensor::rate::SampleRate::from_millihertz(200_000).expect("200 Hz"),
-        gaitclip::sensor::sample::AccelRange::G16.scale(),
-        gaitclip::sensor::sample::GyroRange::Dps2000.scale(),
+        gaitclip_mpu6050::AccelRange::G16.scale(),
+        gaitclip_mpu6050::GyroRange::Dps2000.scale(),
     )
 }
 

@@ -5,11 +5,11 @@
 //! strikes and push-offs clip and their loss is put back), within 1 mm of the twin, and their
 //! direction of travel within what 1 mm allows.
 
-use gaitclip::sensor::sample::{AccelRange, GyroRange};
 use gaitclip_host::io::datasets::root_or_skip;
 use gaitclip_host::io::trace::Ranges;
 use gaitclip_host::reference::cycle_ref::{self, Skipped};
 use gaitclip_host::{io::csv_trace, io::datasets, replay};
+use gaitclip_mpu6050::{AccelRange, GyroRange};
 
 #[test]
 fn cycle_strides_match_the_f64_twin_within_1_mm() {

@@ -2,7 +2,6 @@
 //! in CI). Issue-2 level checks: the chain finds the strides of a real walk and measures them
 //! to within a few percent.
 
-use gaitclip::sensor::sample::RangeScale;
 use gaitclip_host::io::csv_trace;
 use gaitclip_host::io::datasets::root_or_skip;
 use gaitclip_host::io::trace::Ranges;

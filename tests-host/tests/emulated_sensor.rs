@@ -2,10 +2,9 @@
 //! the fixture sample by sample and ends with the trace.
 
 use embedded_hal_mock::eh1::delay::NoopDelay;
-use gaitclip::mpu6050::blocking::Mpu6050;
-use gaitclip::mpu6050::{Address, Config, Error, OutputRate};
-use gaitclip::sensor::sample::RawSample;
 use gaitclip_board::replay_mpu6050;
+use gaitclip_mpu6050::blocking::Mpu6050;
+use gaitclip_mpu6050::{Address, Config, Error, OutputRate};
 use replay_mpu6050::{ReplayBusError, ReplayMpu6050};
 
 #[test]
@@ -25,7 +24,9 @@ fn driver_reads_the_trace_through_the_emulated_bus() {
     loop {
         match imu.read_sample() {
             Ok(s) => {
-                let want = RawSample::from_be_bytes(bytes[n * 14..n * 14 + 14].try_into().unwrap());
+                let want = gaitclip_mpu6050::sample::from_be_bytes(
+                    bytes[n * 14..n * 14 + 14].try_into().unwrap(),
+                );
                 assert_eq!(s, want);
                 n += 1;
             }

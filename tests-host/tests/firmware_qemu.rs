@@ -7,7 +7,6 @@ use gaitclip::pipeline::config::Config;
 use gaitclip::pipeline::detectors::Detector;
 use gaitclip::record::stride::{Stride, StrideFlags};
 use gaitclip::sensor::rate::SampleRate;
-use gaitclip::sensor::sample::RangeScale;
 use gaitclip::sensor::sample::RawSample;
 use gaitclip_board::sleep::{SleepPolicy, SLEEP};
 use gaitclip_board::{replay_holes, replay_mpu6050, replay_still};

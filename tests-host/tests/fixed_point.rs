@@ -6,10 +6,11 @@ use gaitclip::detect::stance::{deflate, StanceThresholds, DEFLATED_IQR_MAX, DEFL
 use gaitclip::detect::zupt::ZuptIntegrator;
 use gaitclip::fixed::{isqrt_u64, mul_q30, QuatQ30, Q30_ONE};
 use gaitclip::sensor::rate::SampleRate;
-use gaitclip::sensor::sample::RangeScale;
-use gaitclip::sensor::sample::{AccelRange, GyroRange, RawSample};
+use gaitclip::sensor::sample::RawSample;
+use gaitclip::sensor::units::{AccelScale, GyroScale};
 use gaitclip::signal::mean_filter::MeanFilter;
 use gaitclip_host::sim::fixtures::FIRMWARE_TRACE;
+use gaitclip_mpu6050::{AccelRange, GyroRange};
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 
@@ -217,18 +218,18 @@ fn sample_rate_conversions() {
 #[test]
 fn rest_thresholds_match_physical_units_within_one_count() {
     for (accel, gyro) in [
-        (AccelRange::G16, GyroRange::Dps2000),
-        (AccelRange::G2, GyroRange::Dps250),
+        (AccelRange::G16.scale(), GyroRange::Dps2000.scale()),
+        (AccelRange::G2.scale(), GyroRange::Dps250.scale()),
+        // ST's ±16 g and ±4 000 °/s (0.488 mg and 140 mdps per count).
+        (
+            AccelScale::from_lsb_per_g(2048),
+            GyroScale::from_mdps_per_lsb(140),
+        ),
     ] {
-        let t = RestThresholds::new(
-            SampleRate::from_hz(200).unwrap(),
-            accel.scale(),
-            gyro.scale(),
-        );
+        let t = RestThresholds::new(SampleRate::from_hz(200).unwrap(), accel, gyro);
         let a = ACCEL_STD_MAX_MMPS2 as f64 / 1000.0 * accel.lsb_per_g() as f64 / 9.80665;
-        let g = GYRO_RMS_MAX_MRADPS as f64 / 1000.0 * 180.0 / std::f64::consts::PI
-            * gyro.lsb_per_dps_x10() as f64
-            / 10.0;
+        let g =
+            GYRO_RMS_MAX_MRADPS as f64 / 1000.0 * 180.0 / std::f64::consts::PI * gyro.lsb_per_dps();
         assert!(((t.accel_var_counts2 as f64).sqrt() - a).abs() <= 1.0);
         assert!(((t.gyro_energy_counts2 as f64).sqrt() - g).abs() <= 1.0);
         assert_eq!(t.window, 10);
@@ -459,7 +460,7 @@ fn zupt_displacement_matches_f64_reference_within_1mm() {
             let movement = &counts[heel_off..end];
             let mut z = ZuptIntegrator::new(
                 rate,
-                gaitclip::sensor::sample::AccelRange::G16.scale(),
+                gaitclip_mpu6050::AccelRange::G16.scale(),
                 GyroRange::Dps2000.scale(),
             );
             let mut sums = RestSums::new();
@@ -632,19 +633,31 @@ fn bridge_cubic_is_the_rounded_lagrange_cubic() {
     }
 }
 
-#[test]
-fn gyro_counts_of_mrad_per_s_within_half_a_count() {
-    for gyro in [
+/// Every gyroscope scale the drivers give: the MPU6050's four (counts per °/s with one
+/// decimal) and ST's (mdps per count: 4.375 at ±125 °/s, 70 at ±2 000, 140 at ±4 000).
+fn gyro_scales() -> Vec<GyroScale> {
+    let mut v: Vec<GyroScale> = [
         GyroRange::Dps250,
         GyroRange::Dps500,
         GyroRange::Dps1000,
         GyroRange::Dps2000,
-    ] {
+    ]
+    .map(|r| r.scale())
+    .to_vec();
+    v.extend([
+        GyroScale::from_ratio(8_000, 35),
+        GyroScale::from_mdps_per_lsb(70),
+        GyroScale::from_mdps_per_lsb(140),
+    ]);
+    v
+}
+
+#[test]
+fn gyro_counts_of_mrad_per_s_within_half_a_count() {
+    for gyro in gyro_scales() {
         for mrad in [0u32, 1, 20, 50, 999, 1000, 34_906, 1_000_000] {
-            let exact = mrad as f64 / 1000.0 * 180.0 / std::f64::consts::PI
-                * gyro.lsb_per_dps_x10() as f64
-                / 10.0;
-            let got = gyro.scale().counts_of_mrad_per_s(mrad) as f64;
+            let exact = mrad as f64 / 1000.0 * 180.0 / std::f64::consts::PI * gyro.lsb_per_dps();
+            let got = gyro.counts_of_mrad_per_s(mrad) as f64;
             assert!(
                 (got - exact).abs() <= 0.5 + exact * 1e-6,
                 "{gyro:?} {mrad}: {got} vs {exact}"
@@ -717,13 +730,15 @@ fn rolling_contact_velocity_matches_f64() {
     use gaitclip::detect::zupt::RollingContact;
     let mut r = rng();
     for (hz, gyro) in [
-        (100, GyroRange::Dps2000),
-        (200, GyroRange::Dps500),
-        (1000, GyroRange::Dps250),
+        (100, GyroRange::Dps2000.scale()),
+        (200, GyroRange::Dps500.scale()),
+        (1000, GyroRange::Dps250.scale()),
+        (800, GyroScale::from_mdps_per_lsb(140)),
+        (100, GyroScale::from_ratio(8_000, 35)),
     ] {
         let rate = SampleRate::from_hz(hz).unwrap();
         for h_um in [0u32, 40_000, 80_000, 120_000] {
-            let rc = RollingContact::new(h_um, rate, gyro.scale());
+            let rc = RollingContact::new(h_um, rate, gyro);
             for _ in 0..2_000 {
                 let q = random_unit(&mut r);
                 let w = [0; 3].map(|_| r.random_range(-20_000i32..20_000));
@@ -731,7 +746,7 @@ fn rolling_contact_velocity_matches_f64() {
                 let v = rc.velocity_q8(q, w, gravity_q8);
                 // Integrator velocity units: v [m/s] = v_q8 · g / (unit_q8 · rate).
                 let to_mps = |x: i64| x as f64 * 9.80665 / (gravity_q8 as f64 * hz as f64);
-                let rad = std::f64::consts::PI / 180.0 / (gyro.lsb_per_dps_x10() as f64 / 10.0);
+                let rad = std::f64::consts::PI / 180.0 / gyro.lsb_per_dps();
                 let wl = rotate_f64(quat_f64(q), w.map(|x| x as f64 * rad));
                 let h = h_um as f64 / 1e6;
                 let exact = [h * wl[1], -h * wl[0], 0.0];

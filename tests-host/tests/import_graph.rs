@@ -273,27 +273,61 @@ fn no_core_stage_imports_a_later_one() {
     assert!(later.is_empty(), "imports of a later stage: {later:?}");
 }
 
-/// The driver is its own crate, ahead of the chain: the core takes its records (the sample,
-/// the ranges) in `sensor/` and re-exports it from `lib.rs`; no later stage names it, so none
-/// can reach a register.
+/// The core does not know which sensor it has: it names only the seam's crate
+/// (`gaitclip_imu`, the sample and the scales), in `sensor/`, and no driver crate anywhere;
+/// the seam and every driver know nothing of gaitclip's core.
 #[test]
-fn only_the_sensor_stage_names_the_driver() {
+fn the_core_names_the_sensor_seam_and_no_driver() {
     let src = repo().join("src");
     let mut files = Vec::new();
     rust_files(&src, &mut files);
-    let mut naming: Vec<String> = files
-        .iter()
-        .filter(|f| code_of(&std::fs::read_to_string(f).unwrap()).contains("gaitclip_mpu6050"))
-        .map(|f| f.strip_prefix(&src).unwrap().to_string_lossy().into_owned())
+    let named = |needle: &str| {
+        let mut v: Vec<String> = files
+            .iter()
+            .filter(|f| code_of(&std::fs::read_to_string(f).unwrap()).contains(needle))
+            .map(|f| f.strip_prefix(&src).unwrap().to_string_lossy().into_owned())
+            .collect();
+        v.sort();
+        v
+    };
+    assert_eq!(
+        named("gaitclip_imu"),
+        ["sensor/sample.rs", "sensor/units.rs"]
+    );
+    let drivers: Vec<String> = std::fs::read_dir(repo().join("drivers"))
+        .unwrap()
+        .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+        .filter(|d| d != "imu")
         .collect();
-    naming.sort();
-    assert_eq!(naming, ["lib.rs", "sensor/sample.rs", "sensor/units.rs"]);
-    // And the driver knows nothing of gaitclip.
-    let mut driver = Vec::new();
-    rust_files(&repo().join("drivers/mpu6050/src"), &mut driver);
-    assert!(driver.len() >= 8);
-    for f in driver {
-        let code = code_of(&std::fs::read_to_string(&f).unwrap());
-        assert!(!code.contains("gaitclip::"), "{}", f.display());
+    assert!(drivers.iter().any(|d| d == "mpu6050"), "{drivers:?}");
+    for d in &drivers {
+        let krate = format!("gaitclip_{}", d.replace('-', "_"));
+        assert_eq!(
+            named(&krate),
+            Vec::<String>::new(),
+            "the core names {krate}"
+        );
+    }
+    let manifest = std::fs::read_to_string(repo().join("Cargo.toml")).unwrap();
+    let deps = manifest
+        .split("[dependencies]")
+        .nth(1)
+        .and_then(|t| t.split("\n[").next())
+        .unwrap();
+    assert!(deps.contains("gaitclip-imu"));
+    for d in &drivers {
+        assert!(
+            !deps.contains(&format!("gaitclip-{d}")),
+            "the core depends on {d}"
+        );
+    }
+    for d in drivers.iter().map(String::as_str).chain(["imu"]) {
+        let mut driver = Vec::new();
+        rust_files(&repo().join("drivers").join(d).join("src"), &mut driver);
+        assert!(!driver.is_empty(), "drivers/{d}");
+        for f in driver {
+            let code = code_of(&std::fs::read_to_string(&f).unwrap());
+            assert!(!code.contains("gaitclip::"), "{}", f.display());
+        }
     }
 }

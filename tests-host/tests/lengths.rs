@@ -8,7 +8,6 @@ use gaitclip::length::fuzzy::{lu_k_q16, D_UNIVERSE_Q16, F_UNIVERSE_Q16};
 use gaitclip::length::models::{self, Model, Settings, MAX_TERMS};
 use gaitclip::record::stride::{Stride, StrideEvents};
 use gaitclip::sensor::rate::SampleRate;
-use gaitclip::sensor::sample::RangeScale;
 use gaitclip_host::reference::length_ref;
 use gaitclip_host::train::fit::least_squares;
 use rand::{Rng, SeedableRng};

@@ -7,8 +7,8 @@ use gaitclip::pipeline::detectors::AnyDetector;
 use gaitclip::pipeline::Pipeline;
 use gaitclip::record::stride::{Stride, StrideFlags, MAX_STRIDE_MM};
 use gaitclip::sensor::rate::SampleRate;
-use gaitclip::sensor::sample::RangeScale;
-use gaitclip::sensor::sample::{AccelRange, GyroRange, RawSample};
+use gaitclip::sensor::sample::RawSample;
+use gaitclip_mpu6050::{AccelRange, GyroRange};
 use proptest::prelude::*;
 
 fn sample() -> impl Strategy<Value = RawSample> {

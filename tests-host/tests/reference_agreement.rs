@@ -1,7 +1,6 @@
 //! The fixed-point core against the `f64` reference of the same stages: the same strides,
 //! and gait events within one sample, on the fixtures and on real recordings.
 
-use gaitclip::sensor::sample::RangeScale;
 use std::path::Path;
 
 use gaitclip::detect::phases::PhaseMethod;

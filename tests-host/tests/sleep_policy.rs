@@ -3,8 +3,6 @@
 //! driver on top), and the emulated part's wake-ups and motion test.
 
 use embedded_hal_mock::eh1::delay::NoopDelay;
-use gaitclip::mpu6050::blocking::Mpu6050;
-use gaitclip::mpu6050::{Address, Config, OutputRate};
 use gaitclip::sensor::rate::SampleRate;
 use gaitclip::sensor::sample::RawSample;
 use gaitclip_board::imu_sampler::{asynch, ImuSampler, Item, ReadMode};
@@ -12,6 +10,8 @@ use gaitclip_board::replay_mpu6050::{
     mg_to_counts, motion_between, periods_per_wake, ReplayMpu6050, WakeTick, REPLAY_MOTION_UNIT,
 };
 use gaitclip_board::sleep::{SleepPolicy, SLEEP, WAKE_THRESHOLD_MG};
+use gaitclip_mpu6050::blocking::Mpu6050;
+use gaitclip_mpu6050::{Address, Config, OutputRate};
 
 const RATE: u32 = 200;
 
@@ -65,7 +65,7 @@ fn trace_of(n: i16) -> &'static [u8] {
             temp: 0,
             gyro: [k, 0, 0],
         };
-        v.extend_from_slice(&s.to_be_bytes());
+        v.extend_from_slice(&gaitclip_mpu6050::sample::to_be_bytes(&s));
     }
     v.leak()
 }
@@ -352,7 +352,7 @@ fn sleep_and_wake_on_the_bus_transaction_by_transaction() {
     // The async sampler of the Bluetooth board: the same transactions and items.
     let mock = Mock::new(&expected);
     let Ok(mut s) = futures_executor::block_on(asynch::ImuSampler::start(
-        gaitclip::mpu6050::asynch::Mpu6050::new(MockBus(mock.clone()), Address::Ad0Low),
+        gaitclip_mpu6050::asynch::Mpu6050::new(MockBus(mock.clone()), Address::Ad0Low),
         NoopDelay,
         config,
         ReadMode::Fifo { batch: 1 },

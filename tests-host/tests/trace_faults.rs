@@ -309,7 +309,7 @@ fn samples_at_the_rails_flag_the_stride() {
     t.samples[i].acc_mps2[2] = 12.0 * G_MPS2;
     let spike16 = replay(&t, Ranges::default()).unwrap();
     let at8 = Ranges {
-        accel: gaitclip::sensor::sample::AccelRange::G8,
+        accel: gaitclip_mpu6050::AccelRange::G8,
         ..Ranges::default()
     };
     let got = replay(&t, at8).unwrap();

@@ -15,12 +15,12 @@ use embedded_hal::delay::DelayNs;
 use embedded_hal::digital::OutputPin;
 use embedded_hal::i2c::I2c;
 use gaitclip::detect::seam::StepDetector;
-use gaitclip::mpu6050;
-use gaitclip::mpu6050::blocking::Mpu6050;
-use gaitclip::mpu6050::mode::Unconfigured;
 use gaitclip::pipeline::config::Config;
 use gaitclip::pipeline::Pipeline;
 use gaitclip::record::stride::Stride;
+use gaitclip_mpu6050 as mpu6050;
+use gaitclip_mpu6050::blocking::Mpu6050;
+use gaitclip_mpu6050::mode::Unconfigured;
 use heapless::spsc::{Consumer, Producer, Queue};
 
 use crate::imu_sampler::{BusRecovery, Counters, ImuSampler, Item, ReadMode};
@@ -209,7 +209,7 @@ where
     }
 
     /// Asks the sampler to sleep after `after` samples in all ([`ImuSampler::request_sleep`]).
-    pub fn request_sleep(&self, after: u32, wake: gaitclip::mpu6050::MotionWakeConfig) {
+    pub fn request_sleep(&self, after: u32, wake: gaitclip_mpu6050::MotionWakeConfig) {
         self.with_sampler(|s, _| s.request_sleep(after, wake));
     }
 }
@@ -350,7 +350,7 @@ where
 /// [`start_sensor`] for the async sampler ([`crate::imu_sampler::asynch`]): the same
 /// retries and reports, the waits awaited.
 pub async fn start_async_sensor<I, D>(
-    mut imu: gaitclip::mpu6050::asynch::Mpu6050<I, gaitclip::mpu6050::mode::Unconfigured>,
+    mut imu: gaitclip_mpu6050::asynch::Mpu6050<I, gaitclip_mpu6050::mode::Unconfigured>,
     mut delay: D,
     config: mpu6050::Config,
     mode: ReadMode,

@@ -2,11 +2,10 @@
 //! nRF52840, Bluetooth and Pico builds measure the same way and the energy budget
 //! (`gaitclip cost`) reads the same figures the firmware uses.
 
-use gaitclip::mpu6050;
 use gaitclip::pipeline::config::Config;
 use gaitclip::sensor::rate::SampleRate;
-use gaitclip::sensor::sample::{AccelRange, GyroRange};
-use gaitclip::sensor::units::{AccelScale, GyroScale};
+use gaitclip_mpu6050 as mpu6050;
+use gaitclip_mpu6050::{AccelRange, GyroRange};
 
 /// Output data rate of the sensor, Hz.
 pub const RATE_HZ: u16 = 200;
@@ -30,7 +29,7 @@ pub const CONFIG: Config = config(RATE, ACCEL, GYRO);
 /// The pipeline's configuration for samples at `rate` in the given ranges, with the
 /// firmware's [`crate::DETECTOR`].
 pub const fn config(rate: SampleRate, accel: AccelRange, gyro: GyroRange) -> Config {
-    let mut c = Config::new(rate, AccelScale::of(accel), GyroScale::of(gyro));
+    let mut c = Config::new(rate, accel.scale(), gyro.scale());
     c.detector = crate::DETECTOR;
     c
 }

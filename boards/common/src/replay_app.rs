@@ -15,17 +15,16 @@
 //! `replay-sleep` feature the sensor holds still for the runs of [`STILL`].
 
 use core::sync::atomic::{AtomicBool, Ordering};
-use gaitclip::sensor::sample::RangeScale;
 
 use cortex_m::interrupt as irq;
 use cortex_m_semihosting::debug::{self, EXIT_FAILURE, EXIT_SUCCESS};
 use gaitclip::detect::seam::StepDetector;
-use gaitclip::mpu6050::blocking::Mpu6050;
-use gaitclip::mpu6050::{self, Address};
 use gaitclip::pipeline::config::Config;
 use gaitclip::pipeline::Pipeline;
 use gaitclip::sensor::rate::SampleRate;
-use gaitclip::sensor::sample::{AccelRange, GyroRange, SAMPLE_BYTES};
+use gaitclip_mpu6050::blocking::Mpu6050;
+use gaitclip_mpu6050::{self as mpu6050, Address};
+use gaitclip_mpu6050::{AccelRange, GyroRange, SAMPLE_BYTES};
 use heapless::spsc::Queue;
 
 use crate::imu_sampler::{ImuSampler, Item, ReadMode};

@@ -28,7 +28,7 @@
 //! Board glue, not core: it is safe code but knows a storage format.
 
 use embedded_hal::i2c::{self, ErrorKind, NoAcknowledgeSource, Operation, SevenBitAddress};
-use gaitclip::mpu6050::MotionThresholdUnit;
+use gaitclip_mpu6050::MotionThresholdUnit;
 
 const WHO_AM_I: u8 = 0x75;
 const DATA_FIRST: u8 = 0x3B;

@@ -9,7 +9,7 @@
 //! 1. the main loop asks the sampler to sleep ahead of anything still queued
 //!    ([`crate::imu_sampler::ImuSampler::request_sleep`], [`SleepPolicy::sleep_after`]),
 //!    and the sampler puts the sensor in its cycle mode with the motion interrupt latched on
-//!    INT ([`gaitclip::mpu6050::blocking::Mpu6050::enter_motion_wake`]) and queues
+//!    INT ([`gaitclip_mpu6050::blocking::Mpu6050::enter_motion_wake`]) and queues
 //!    [`crate::imu_sampler::Item::Asleep`];
 //! 2. the board stops its sample-side timers (the sensor watchdog: a sleeping sensor is
 //!    silent by design), says so on its outputs, and the core waits for INT (System ON,
@@ -25,8 +25,8 @@
 //! Everything here is plain state, so the host tests (`tests-host/tests/sleep_policy.rs`)
 //! and the host model of the sleeping replay firmware use this very code.
 
-use gaitclip::mpu6050::{MotionThreshold, MotionThresholdUnit, MotionWakeConfig, WakeRate};
 use gaitclip::sensor::rate::SampleRate;
+use gaitclip_mpu6050::{MotionThreshold, MotionThresholdUnit, MotionWakeConfig, WakeRate};
 
 use crate::imu_sampler::Item;
 

@@ -98,10 +98,11 @@ impl Startup {
                 }
                 Some(f) => {
                     self.stage = Stage::WaitingForHeading;
-                    let lsb_x10 = self.gyro.lsb_per_dps_x10() as i64;
+                    // counts · dps/lsb °/s, in m°/s.
+                    let (lsb, dps) = (self.gyro.lsb() as i64, self.gyro.dps() as i64);
                     let gyro_bias_mdps = pipeline
                         .gyro_bias()
-                        .map(|c| (c as i64 * 10_000 / lsb_x10) as i32);
+                        .map(|c| (c as i64 * 1_000 * dps / lsb) as i32);
                     let gravity_mg = (f.gravity() as i64 * 1000
                         / gaitclip::sensor::units::FOOT_LSB_PER_G as i64)
                         as i32;

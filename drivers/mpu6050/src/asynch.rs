@@ -132,7 +132,7 @@ impl<I: I2c> Mpu6050<I, Sampling> {
         self.i2c
             .write_read(self.address, &[reg::ACCEL_XOUT_H], &mut buf)
             .await?;
-        Ok(RawSample::from_be_bytes(&buf))
+        Ok(crate::sample::from_be_bytes(&buf))
     }
 
     /// Drives INT on data ready (and FIFO overflow), latched until any register read
@@ -189,7 +189,7 @@ impl<I: I2c> Mpu6050<I, Sampling> {
             self.i2c
                 .write_read(self.address, &[reg::FIFO_R_W], &mut buf)
                 .await?;
-            *slot = RawSample::from_be_bytes(&buf);
+            *slot = crate::sample::from_be_bytes(&buf);
         }
         Ok(n)
     }

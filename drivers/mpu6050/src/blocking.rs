@@ -124,7 +124,7 @@ impl<I: I2c> Mpu6050<I, Sampling> {
         let mut buf = [0u8; SAMPLE_BYTES];
         self.i2c
             .write_read(self.address, &[reg::ACCEL_XOUT_H], &mut buf)?;
-        Ok(RawSample::from_be_bytes(&buf))
+        Ok(crate::sample::from_be_bytes(&buf))
     }
 
     /// Drives INT on data ready (and FIFO overflow), latched until any register read
@@ -179,7 +179,7 @@ impl<I: I2c> Mpu6050<I, Sampling> {
             let mut buf = [0u8; SAMPLE_BYTES];
             self.i2c
                 .write_read(self.address, &[reg::FIFO_R_W], &mut buf)?;
-            *slot = RawSample::from_be_bytes(&buf);
+            *slot = crate::sample::from_be_bytes(&buf);
         }
         Ok(n)
     }

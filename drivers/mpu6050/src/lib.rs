@@ -61,13 +61,14 @@ pub mod mode;
 pub mod program;
 mod range;
 pub mod register;
-mod sample;
+pub mod sample;
 mod settings;
 
 pub use error::{Error, ModeChangeError};
+pub use gaitclip_imu::{AccelScale, GyroScale, RawSample};
 pub use range::{AccelRange, GyroRange};
 pub use register::{FIFO_CAPACITY_BYTES, RESET_DELAY_MS, WHO_AM_I_VALUE};
-pub use sample::{RawSample, SAMPLE_BYTES};
+pub use sample::SAMPLE_BYTES;
 pub use settings::{
     Address, Config, InterruptStatus, MotionThreshold, MotionThresholdUnit, MotionWakeConfig,
     OutputRate, WakeRate,

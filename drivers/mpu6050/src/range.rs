@@ -1,6 +1,8 @@
 //! The full-scale ranges and their sensitivities (product specification PS-MPU-6000A-00
 //! rev 3.4, §6.1–6.2).
 
+use gaitclip_imu::{AccelScale, GyroScale};
+
 /// Accelerometer full-scale range (register `ACCEL_CONFIG.AFS_SEL`).
 ///
 /// The default is ±16 g: heel strikes of a foot-mounted sensor exceed 8 g.
@@ -21,6 +23,11 @@ impl AccelRange {
     /// Counts per g (datasheet sensitivity).
     pub const fn lsb_per_g(self) -> u32 {
         16384 >> self.afs_sel()
+    }
+
+    /// The scale the pipeline takes this range's counts in.
+    pub const fn scale(self) -> AccelScale {
+        AccelScale::from_lsb_per_g(self.lsb_per_g())
     }
 
     /// The range for an `AFS_SEL` field value; `None` above 3.
@@ -68,6 +75,11 @@ impl GyroRange {
             GyroRange::Dps1000 => 328,
             GyroRange::Dps2000 => 164,
         }
+    }
+
+    /// The scale the pipeline takes this range's counts in.
+    pub const fn scale(self) -> GyroScale {
+        GyroScale::from_lsb_per_dps_x10(self.lsb_per_dps_x10())
     }
 
     /// The range for an `FS_SEL` field value; `None` above 3.

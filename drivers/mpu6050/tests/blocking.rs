@@ -144,7 +144,7 @@ fn burst_read_decodes_big_endian_accel_temp_gyro() {
         }
     );
     assert!(s.is_saturated());
-    assert_eq!(s.to_be_bytes().to_vec(), regs);
+    assert_eq!(gaitclip_mpu6050::sample::to_be_bytes(&s).to_vec(), regs);
     bus.done();
 }
 

@@ -18,9 +18,9 @@
 
 use std::fmt::Write as _;
 
-use gaitclip::mpu6050::WakeRate;
 use gaitclip_board::live_settings::{FIFO_BATCH, RATE_HZ};
 use gaitclip_board::sleep::SLEEP;
+use gaitclip_mpu6050::WakeRate;
 
 use crate::eval::markdown::{Column, Table};
 

@@ -12,7 +12,6 @@
 //! The counting runs are [`crate::cost::insn_count`]; this module builds the firmware, measures
 //! sizes and stacks, and writes the report.
 
-use gaitclip::sensor::sample::RangeScale;
 use std::fmt::Write as _;
 
 use anyhow::{ensure, Context, Result};

@@ -28,7 +28,8 @@
 
 use anyhow::Result;
 use gaitclip::record::stride::{Stride, StrideFlags};
-use gaitclip::sensor::sample::{AccelRange, GyroRange, Rails, RawSample};
+use gaitclip::sensor::sample::{Rails, RawSample};
+use gaitclip_mpu6050::{AccelRange, GyroRange};
 
 use crate::eval::markdown::{cm_cell, median_p95_beside, Table};
 use crate::io::datasets;

@@ -16,7 +16,7 @@
 use anyhow::Result;
 use gaitclip::pipeline::config::BRIDGE_MAX_MS;
 use gaitclip::record::stride::{Stride, StrideFlags};
-use gaitclip::sensor::sample::{AccelRange, GyroRange};
+use gaitclip_mpu6050::{AccelRange, GyroRange};
 
 use crate::eval::clip_sweep::{self, Clipping};
 use crate::eval::hole_sweep::{self, Pattern};

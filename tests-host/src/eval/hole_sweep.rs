@@ -25,7 +25,6 @@
 //! [`MEAN_LENGTH_BOUND_M`].
 
 use crate::eval::stats::quantile;
-use gaitclip::sensor::sample::RangeScale;
 use std::fmt::Write as _;
 use std::path::Path;
 

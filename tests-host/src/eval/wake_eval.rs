@@ -15,7 +15,6 @@
 //! * **slept through**: no wake-up within [`MISSED_S`] of the movement's start: a walk whose
 //!   first stride would be lost entirely.
 
-use gaitclip::sensor::sample::RangeScale;
 use std::path::Path;
 
 use anyhow::{Context, Result};

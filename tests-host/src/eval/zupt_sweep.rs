@@ -19,7 +19,7 @@ use std::fmt::Write as _;
 use std::path::Path;
 
 use anyhow::Result;
-use gaitclip::sensor::sample::{AccelRange, GyroRange};
+use gaitclip_mpu6050::{AccelRange, GyroRange};
 
 use crate::eval::bias;
 use crate::eval::length_eval::SPEED_BINS;

@@ -1,7 +1,8 @@
 //! A recorded trace in physical units and its conversion to MPU6050 counts.
 
 use gaitclip::sensor::rate::SampleRate;
-use gaitclip::sensor::sample::{AccelRange, GyroRange, RawSample};
+use gaitclip::sensor::sample::RawSample;
+use gaitclip_mpu6050::{AccelRange, GyroRange};
 use serde::Serialize;
 
 /// Standard gravity, m/s² per g.

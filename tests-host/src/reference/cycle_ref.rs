@@ -114,7 +114,7 @@ pub fn energy(config: &Config, s: &RawSample, bias: [i32; 3], gravity_counts: i3
 }
 
 fn rad_per_count(config: &Config) -> f64 {
-    std::f64::consts::PI / 180.0 / (config.gyro.lsb_per_dps_x10() as f64 / 10.0)
+    std::f64::consts::PI / 180.0 / (config.gyro.lsb_per_dps())
 }
 
 /// Why the twin did not measure a stride.

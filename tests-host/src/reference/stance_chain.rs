@@ -19,7 +19,6 @@ use gaitclip::detect::{rest, stance};
 use gaitclip::pipeline::config::Config;
 use gaitclip::pipeline::MEAN_FILTER_MS;
 use gaitclip::sensor::rate::SampleRate;
-use gaitclip::sensor::sample::RangeScale;
 use gaitclip::sensor::sample::RawSample;
 use nalgebra::{Matrix3, SymmetricEigen, Vector3};
 
@@ -31,7 +30,7 @@ use gaitclip::record::stride::StrideEvents;
 pub fn strides(samples: &[RawSample], config: Config) -> Vec<Detected> {
     let (ka, kg) = (
         config.accel.lsb_per_g() as f64 / G_MPS2,
-        config.gyro.lsb_per_dps_x10() as f64 / 10.0 * 180.0 / std::f64::consts::PI,
+        config.gyro.lsb_per_dps() * 180.0 / std::f64::consts::PI,
     );
     let acc: Vec<Vector3<f64>> = samples
         .iter()
@@ -64,14 +63,11 @@ impl Reference {
             // Power of two nearest n, at most 16.
             (2f64.powf(n.log2().round())).min(16.0) as usize
         };
-        let t = stance::StanceThresholds::new(
-            rate,
-            gaitclip::sensor::sample::GyroRange::Dps2000.scale(),
-        );
+        let t = stance::StanceThresholds::new(rate, gaitclip_mpu6050::GyroRange::Dps2000.scale());
         let r = rest::RestThresholds::new(
             rate,
-            gaitclip::sensor::sample::AccelRange::default().scale(),
-            gaitclip::sensor::sample::GyroRange::default().scale(),
+            gaitclip_mpu6050::AccelRange::default().scale(),
+            gaitclip_mpu6050::GyroRange::default().scale(),
         );
         Reference {
             filter_len,

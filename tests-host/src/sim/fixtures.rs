@@ -20,9 +20,9 @@ pub fn firmware_trace_counts() -> std::io::Result<Vec<gaitclip::sensor::sample::
         .join(format!("{FIRMWARE_TRACE}.mpu6050"));
     let bytes = fs::read(path)?;
     Ok(bytes
-        .chunks_exact(gaitclip::sensor::sample::SAMPLE_BYTES)
+        .chunks_exact(gaitclip_mpu6050::SAMPLE_BYTES)
         .filter_map(|c| c.try_into().ok())
-        .map(|c| gaitclip::sensor::sample::RawSample::from_be_bytes(&c))
+        .map(|c| gaitclip_mpu6050::sample::from_be_bytes(&c))
         .collect())
 }
 
@@ -102,7 +102,10 @@ pub fn write_trace_module(
     counts: &[gaitclip::sensor::sample::RawSample],
 ) -> anyhow::Result<()> {
     let path = |ext: &str| dir.join(format!("{name}.{ext}"));
-    let bytes: Vec<u8> = counts.iter().flat_map(|c| c.to_be_bytes()).collect();
+    let bytes: Vec<u8> = counts
+        .iter()
+        .flat_map(gaitclip_mpu6050::sample::to_be_bytes)
+        .collect();
     fs::write(path("mpu6050"), bytes)?;
     let mut rs = fs::File::create(path("rs"))?;
     for line in doc.lines() {

@@ -5,10 +5,10 @@
 
 use embedded_hal_async::delay::DelayNs;
 use embedded_hal_async::i2c::I2c;
-use gaitclip::mpu6050::asynch::Mpu6050;
-use gaitclip::mpu6050::mode::{MotionWake, Sampling, Unconfigured};
-use gaitclip::mpu6050::{self, MotionWakeConfig};
 use gaitclip::sensor::sample::RawSample;
+use gaitclip_mpu6050::asynch::Mpu6050;
+use gaitclip_mpu6050::mode::{MotionWake, Sampling, Unconfigured};
+use gaitclip_mpu6050::{self as mpu6050, MotionWakeConfig};
 
 use super::ledger::{Due, Ledger};
 use super::{BusRecovery, Counters, Item, ReadMode, FIFO_BURST, RETRIES};

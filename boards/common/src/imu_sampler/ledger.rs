@@ -2,8 +2,8 @@
 //! does to the counters and the queue. [`super::blocking`] and [`super::asynch`] perform the
 //! transfers and report each outcome here, so the two samplers cannot count differently.
 
-use gaitclip::mpu6050::MotionWakeConfig;
 use gaitclip::sensor::sample::RawSample;
+use gaitclip_mpu6050::MotionWakeConfig;
 
 use super::{Counters, Item, ReadMode, FIFO_BURST, RESTART_AFTER};
 
