@@ -38,12 +38,11 @@ pub const DEFAULT_MODEL: Model = crate::length::trained::LODO_BEST;
 pub struct Config {
     /// Sample rate.
     pub rate: SampleRate,
-    /// Accelerometer scale of the counts (counts per g; the MPU6050's from
-    /// [`crate::sensor::units::AccelScale::of`]).
+    /// Accelerometer scale of the counts (counts per g), as the sensor's driver gives it.
     pub accel: AccelScale,
-    /// Gyroscope scale of the counts (counts per °/s; [`crate::sensor::units::GyroScale::of`]).
+    /// Gyroscope scale of the counts (counts per °/s), as the sensor's driver gives it.
     pub gyro: GyroScale,
-    /// Where each axis clips, counts ([`Rails::FULL_SCALE`] for the MPU6050; a replayed
+    /// Where each axis clips, counts ([`Rails::FULL_SCALE`] for a part read live; a replayed
     /// recording's are learnt from its data or given).
     pub rails: Rails,
     /// Whether the cycle detector puts back what a clipped accelerometer lost
