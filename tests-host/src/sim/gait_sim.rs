@@ -49,6 +49,45 @@ pub const ACC_BIAS_MAX_MPS2: f64 = 0.1;
 /// Largest gyro bias, rad/s (uniform in ±; 1 °/s).
 pub const GYR_BIAS_MAX_RADPS: f64 = 0.017;
 
+/// How hard the foot moves over a movement: a walk's figures, or a sprint's. Every term is a
+/// displacement or an attitude of the foot (the dip, the snap), so the specific force and
+/// body rate that the central differences take from them integrate back to the stride
+/// itself; only the walk's heel-strike oscillation ([`IMPACT_G`]) is added to the
+/// acceleration alone.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Vigour {
+    /// Peak of the heel-strike oscillation added to the acceleration, g.
+    pub impact_g: f64,
+    /// Foot clearance, m.
+    pub clearance_m: f64,
+    /// Peak pitch, rad.
+    pub pitch_rad: f64,
+    /// Touch-down: the foot's origin dips by this much and comes back, m, as
+    /// `−d·sin⁴(πu/D)` over [`Vigour::dip_s`] from heel-strike: a specific force of
+    /// `4·d·(π/D)²` upward at its middle.
+    pub dip_m: f64,
+    /// The dip's duration `D`, s.
+    pub dip_s: f64,
+    /// Toe-off: the foot plantar-flexes by this much more and comes back, rad, as
+    /// `−A·sin²(πu/S)` over [`Vigour::snap_s`] from toe-off: a pitch rate of `±A·π/S`.
+    pub snap_rad: f64,
+    /// The snap's duration `S`, s.
+    pub snap_s: f64,
+}
+
+impl Vigour {
+    /// A walk: the figures the committed fixtures were made with.
+    pub const WALK: Vigour = Vigour {
+        impact_g: IMPACT_G,
+        clearance_m: CLEARANCE_M,
+        pitch_rad: PITCH_RAD,
+        dip_m: 0.0,
+        dip_s: 0.0,
+        snap_rad: 0.0,
+        snap_s: 0.0,
+    };
+}
+
 /// One piece of a scenario.
 #[derive(Clone, Debug, Serialize)]
 pub enum Segment {
@@ -86,6 +125,9 @@ pub struct Scenario {
     pub seed: u64,
     /// The walk.
     pub segments: Vec<Segment>,
+    /// How hard the foot moves (not written to the fixtures' descriptions).
+    #[serde(skip)]
+    pub vigour: Vigour,
 }
 
 /// Ground truth of one stride, indices into the generated samples.
@@ -143,7 +185,7 @@ fn min_jerk(tau: f64) -> f64 {
 }
 
 /// Foot pose at time `t`: position (m) and Euler (pitch, yaw) in rad; roll is zero.
-fn pose(moves: &[Movement], rest: ([f64; 2], f64), t: f64) -> ([f64; 3], f64, f64) {
+fn pose(moves: &[Movement], rest: ([f64; 2], f64), v: &Vigour, t: f64) -> ([f64; 3], f64, f64) {
     // The last movement that started at or before t (movements are sorted by time).
     let m = moves.iter().take_while(|m| m.t0 <= t).last();
     let Some(m) = m else {
@@ -155,8 +197,18 @@ fn pose(moves: &[Movement], rest: ([f64; 2], f64), t: f64) -> ([f64; 3], f64, f6
     let x = m.from[0] + m.length * s * dir.cos();
     let y = m.from[1] + m.length * s * dir.sin();
     let sp = (PI * tau).sin();
-    let z = CLEARANCE_M * sp.powi(4) * if m.length > 0.3 { 1.0 } else { m.length / 0.3 };
-    let pitch = -PITCH_RAD * (2.0 * PI * tau).sin() * sp * sp * (m.length / 1.4).min(1.2);
+    let mut z = v.clearance_m * sp.powi(4) * if m.length > 0.3 { 1.0 } else { m.length / 0.3 };
+    let mut pitch = -v.pitch_rad * (2.0 * PI * tau).sin() * sp * sp * (m.length / 1.4).min(1.2);
+    let within = |from_tau: f64, dur: f64| {
+        let u = (t - (m.t0 + from_tau * m.dur)) / dur;
+        (dur > 0.0 && (0.0..=1.0).contains(&u)).then_some(u)
+    };
+    if let Some(u) = within(HEEL_STRIKE_TAU, v.dip_s) {
+        z -= v.dip_m * (PI * u).sin().powi(4);
+    }
+    if let Some(u) = within(TOE_OFF_TAU, v.snap_s) {
+        pitch -= v.snap_rad * (PI * u).sin().powi(2);
+    }
     let yaw = m.heading0 + m.turn * s;
     ([x, y, z], pitch, yaw)
 }
@@ -203,78 +255,107 @@ pub fn rotation_from_deg(rpy: [f64; 3]) -> Mat {
     mat_mul(&rot_z(r[2]), &mat_mul(&rot_y(r[1]), &rot_x(r[0])))
 }
 
-/// Runs a scenario.
-pub fn simulate(sc: &Scenario, ranges: Ranges) -> Simulated {
-    let mut rng = ChaCha8Rng::seed_from_u64(sc.seed);
-    let dt = 1.0 / sc.rate_hz;
-    // Plan the movements.
-    let mut moves = Vec::new();
-    let mut plan = Vec::new(); // (stance start time, movement index, flag)
-    let (mut t, mut pos, mut heading) = (0.0f64, [0.0f64; 2], 0.0f64);
-    let mut last_stance_start = 0.0;
-    for seg in &sc.segments {
-        match *seg {
-            Segment::Stand(d) => t += d,
-            Segment::Walk {
-                strides,
-                length_m,
-                stance_s,
-                movement_s,
-                turn_deg,
-                flag,
-            } => {
-                for _ in 0..strides {
-                    t += stance_s;
-                    let turn = turn_deg.to_radians();
-                    let m = Movement {
-                        t0: t,
-                        dur: movement_s,
-                        from: pos,
-                        length: length_m,
-                        heading0: heading,
-                        turn,
-                    };
-                    let dir = heading + turn * 0.5;
-                    pos = [pos[0] + length_m * dir.cos(), pos[1] + length_m * dir.sin()];
-                    heading += turn;
-                    plan.push((last_stance_start, moves.len(), flag, turn_deg));
-                    moves.push(m);
-                    t += movement_s;
-                    last_stance_start = t;
+/// A scenario's foot and sensor in continuous time: what the sensor feels at any instant,
+/// before it is sampled and quantised.
+pub struct Trajectory {
+    moves: Vec<Movement>,
+    /// (stance start time, movement index, flag, turn °) per stride.
+    plan: Vec<(f64, usize, &'static str, f64)>,
+    vigour: Vigour,
+    /// Sensor → foot.
+    mount_t: Mat,
+    acc_bias: [f64; 3],
+    gyr_bias: [f64; 3],
+    acc_noise: Normal<f64>,
+    gyr_noise: Normal<f64>,
+    /// The scenario's length, s.
+    pub duration_s: f64,
+}
+
+impl Trajectory {
+    /// Plans `sc`'s movements and draws the sensor's biases from `rng`.
+    pub fn new(sc: &Scenario, rng: &mut ChaCha8Rng) -> Trajectory {
+        let mut moves = Vec::new();
+        let mut plan = Vec::new();
+        let (mut t, mut pos, mut heading) = (0.0f64, [0.0f64; 2], 0.0f64);
+        let mut last_stance_start = 0.0;
+        for seg in &sc.segments {
+            match *seg {
+                Segment::Stand(d) => t += d,
+                Segment::Walk {
+                    strides,
+                    length_m,
+                    stance_s,
+                    movement_s,
+                    turn_deg,
+                    flag,
+                } => {
+                    for _ in 0..strides {
+                        t += stance_s;
+                        let turn = turn_deg.to_radians();
+                        let m = Movement {
+                            t0: t,
+                            dur: movement_s,
+                            from: pos,
+                            length: length_m,
+                            heading0: heading,
+                            turn,
+                        };
+                        let dir = heading + turn * 0.5;
+                        pos = [pos[0] + length_m * dir.cos(), pos[1] + length_m * dir.sin()];
+                        heading += turn;
+                        plan.push((last_stance_start, moves.len(), flag, turn_deg));
+                        moves.push(m);
+                        t += movement_s;
+                        last_stance_start = t;
+                    }
                 }
             }
         }
+        let acc_bias: [f64; 3] =
+            [0; 3].map(|_| rng.random_range(-ACC_BIAS_MAX_MPS2..ACC_BIAS_MAX_MPS2));
+        let gyr_bias: [f64; 3] =
+            [0; 3].map(|_| rng.random_range(-GYR_BIAS_MAX_RADPS..GYR_BIAS_MAX_RADPS));
+        Trajectory {
+            moves,
+            plan,
+            vigour: sc.vigour,
+            mount_t: transpose(&rotation_from_deg(sc.mounting_deg)),
+            acc_bias,
+            gyr_bias,
+            acc_noise: Normal::new(0.0, ACC_NOISE_MPS2).expect("valid sigma"),
+            gyr_noise: Normal::new(0.0, GYR_NOISE_RADPS).expect("valid sigma"),
+            duration_s: t,
+        }
     }
-    let total = t;
-    let n = (total * sc.rate_hz).floor() as usize + 1;
-    let mount = rotation_from_deg(sc.mounting_deg); // sensor → foot
-    let mount_t = transpose(&mount);
-    let acc_noise = Normal::new(0.0, ACC_NOISE_MPS2).expect("valid sigma");
-    let gyr_noise = Normal::new(0.0, GYR_NOISE_RADPS).expect("valid sigma");
-    let acc_bias: [f64; 3] =
-        [0; 3].map(|_| rng.random_range(-ACC_BIAS_MAX_MPS2..ACC_BIAS_MAX_MPS2));
-    let gyr_bias: [f64; 3] =
-        [0; 3].map(|_| rng.random_range(-GYR_BIAS_MAX_RADPS..GYR_BIAS_MAX_RADPS));
-    let rest = ([0.0, 0.0], 0.0);
-    let foot_rot = |t: f64| {
-        let (_, pitch, yaw) = pose(&moves, rest, t);
-        mat_mul(&rot_z(yaw), &rot_y(pitch)) // foot → nav
-    };
-    let h = 1e-5;
-    let mut samples = Vec::with_capacity(n);
-    let mut counts = Vec::with_capacity(n);
-    for i in 0..n {
-        let t = i as f64 * dt;
-        let p = |t| pose(&moves, rest, t).0;
+
+    fn pose(&self, t: f64) -> ([f64; 3], f64, f64) {
+        pose(&self.moves, ([0.0, 0.0], 0.0), &self.vigour, t)
+    }
+
+    /// Foot → nav.
+    fn foot_rot(&self, t: f64) -> Mat {
+        let (_, pitch, yaw) = self.pose(t);
+        mat_mul(&rot_z(yaw), &rot_y(pitch))
+    }
+
+    /// What the sensor feels at `t` (specific force, m/s², and body rate, rad/s, in its own
+    /// frame), without bias or noise.
+    pub fn exact(&self, t: f64) -> ([f64; 3], [f64; 3]) {
+        let h = 1e-5;
+        let p = |t| self.pose(t).0;
         let (pm, p0, pp) = (p(t - h), p(t), p(t + h));
         let mut acc_n = [0, 1, 2].map(|k| (pp[k] - 2.0 * p0[k] + pm[k]) / (h * h));
         // Heel-strike impact along the foot's vertical.
-        let r_nf = foot_rot(t);
-        for m in &moves {
+        let r_nf = self.foot_rot(t);
+        for m in &self.moves {
             let t_hs = m.t0 + HEEL_STRIKE_TAU * m.dur;
             let u = t - t_hs;
             if (0.0..0.08).contains(&u) && m.length > 0.3 {
-                let a = IMPACT_G * G_MPS2 * (-u / 0.012).exp() * (2.0 * PI * 35.0 * u).sin();
+                let a = self.vigour.impact_g
+                    * G_MPS2
+                    * (-u / 0.012).exp()
+                    * (2.0 * PI * 35.0 * u).sin();
                 let v = mat_vec(&r_nf, [0.0, 0.0, a]);
                 for k in 0..3 {
                     acc_n[k] += v[k];
@@ -283,7 +364,7 @@ pub fn simulate(sc: &Scenario, ranges: Ranges) -> Simulated {
         }
         acc_n[2] += G_MPS2; // specific force: the ground pushes up at rest
                             // Body rate from the rotation's derivative: [ω]× = Rᵀ·dR/dt.
-        let (rm, rp) = (foot_rot(t - h), foot_rot(t + h));
+        let (rm, rp) = (self.foot_rot(t - h), self.foot_rot(t + h));
         let mut dr = [[0.0; 3]; 3];
         for a in 0..3 {
             for b in 0..3 {
@@ -292,14 +373,56 @@ pub fn simulate(sc: &Scenario, ranges: Ranges) -> Simulated {
         }
         let w = mat_mul(&transpose(&r_nf), &dr);
         let omega_f = [w[2][1], w[0][2], w[1][0]];
-        let r_sn = mat_mul(&mount_t, &transpose(&r_nf)); // nav → sensor
-        let f_s = mat_vec(&r_sn, acc_n);
-        let w_s = mat_vec(&mount_t, omega_f);
-        let phys = ImuSample {
+        let r_sn = mat_mul(&self.mount_t, &transpose(&r_nf)); // nav → sensor
+        (mat_vec(&r_sn, acc_n), mat_vec(&self.mount_t, omega_f))
+    }
+
+    /// What the sensor reads at `t` before quantisation: [`Trajectory::exact`] with its
+    /// biases and white noise drawn from `rng`.
+    pub fn sample(&self, t: f64, rng: &mut ChaCha8Rng) -> ImuSample {
+        let (f_s, w_s) = self.exact(t);
+        ImuSample {
             t_s: t,
-            acc_mps2: [0, 1, 2].map(|k| f_s[k] + acc_bias[k] + acc_noise.sample(&mut rng)),
-            gyr_radps: [0, 1, 2].map(|k| w_s[k] + gyr_bias[k] + gyr_noise.sample(&mut rng)),
-        };
+            acc_mps2: [0, 1, 2].map(|k| f_s[k] + self.acc_bias[k] + self.acc_noise.sample(rng)),
+            gyr_radps: [0, 1, 2].map(|k| w_s[k] + self.gyr_bias[k] + self.gyr_noise.sample(rng)),
+        }
+    }
+
+    /// The ground truth, the events as sample indices at `rate_hz`.
+    pub fn truth(&self, rate_hz: f64) -> Vec<TruthStride> {
+        let idx = |t: f64| (t * rate_hz).round() as u32;
+        self.plan
+            .iter()
+            .enumerate()
+            .map(|(k, &(stance_start, mi, flag, turn_deg))| {
+                let m = &self.moves[mi];
+                TruthStride {
+                    stride: k as u32,
+                    start_idx: idx(stance_start),
+                    heel_off_idx: idx(m.t0),
+                    toe_off_idx: idx(m.t0 + TOE_OFF_TAU * m.dur),
+                    heel_strike_idx: idx(m.t0 + HEEL_STRIKE_TAU * m.dur),
+                    end_idx: idx(m.t0 + m.dur),
+                    length_m: m.length,
+                    turn_deg,
+                    flag,
+                }
+            })
+            .collect()
+    }
+}
+
+/// Runs a scenario.
+pub fn simulate(sc: &Scenario, ranges: Ranges) -> Simulated {
+    let mut rng = ChaCha8Rng::seed_from_u64(sc.seed);
+    let tr = Trajectory::new(sc, &mut rng);
+    let n = (tr.duration_s * sc.rate_hz).floor() as usize + 1;
+    let mut samples = Vec::with_capacity(n);
+    let mut counts = Vec::with_capacity(n);
+    let dt = 1.0 / sc.rate_hz;
+    for i in 0..n {
+        let t = i as f64 * dt;
+        let phys = tr.sample(t, &mut rng);
         let c = ranges.to_counts(&phys);
         // What the file holds is what the sensor reported: the quantised value.
         let q = ranges.to_physical(round6(t), &c);
@@ -310,29 +433,10 @@ pub fn simulate(sc: &Scenario, ranges: Ranges) -> Simulated {
         });
         counts.push(c);
     }
-    let idx = |t: f64| (t * sc.rate_hz).round() as u32;
-    let truth = plan
-        .iter()
-        .enumerate()
-        .map(|(k, &(stance_start, mi, flag, turn_deg))| {
-            let m = &moves[mi];
-            TruthStride {
-                stride: k as u32,
-                start_idx: idx(stance_start),
-                heel_off_idx: idx(m.t0),
-                toe_off_idx: idx(m.t0 + TOE_OFF_TAU * m.dur),
-                heel_strike_idx: idx(m.t0 + HEEL_STRIKE_TAU * m.dur),
-                end_idx: idx(m.t0 + m.dur),
-                length_m: m.length,
-                turn_deg,
-                flag,
-            }
-        })
-        .collect();
     Simulated {
         samples,
         counts,
-        truth,
+        truth: tr.truth(sc.rate_hz),
     }
 }
 
@@ -363,6 +467,7 @@ pub fn scenarios() -> Vec<Scenario> {
             rate_hz: 200.0,
             mounting_deg: [85.0, -15.0, 100.0],
             seed: 1,
+            vigour: Vigour::WALK,
             segments: vec![
                 Segment::Stand(2.0),
                 walk(1, 0.8, 1.2, 0.0, "first"),
@@ -382,6 +487,7 @@ pub fn scenarios() -> Vec<Scenario> {
             rate_hz: 100.0,
             mounting_deg: [180.0, 10.0, -30.0],
             seed: 2,
+            vigour: Vigour::WALK,
             segments: vec![
                 Segment::Stand(1.5),
                 walk(1, 0.75, 1.2, 0.0, "first"),
@@ -398,6 +504,7 @@ pub fn scenarios() -> Vec<Scenario> {
             rate_hz: 500.0,
             mounting_deg: [-90.0, 0.0, 180.0],
             seed: 3,
+            vigour: Vigour::WALK,
             segments: vec![
                 Segment::Stand(1.0),
                 walk(1, 0.9, 1.0, 0.0, "first"),
