@@ -74,6 +74,8 @@ mod rsc;
 mod rsc_gatt;
 #[path = "sleep_policy.rs"]
 mod sleep_policy;
+#[path = "sprint.rs"]
+mod sprint;
 #[path = "stream.rs"]
 mod stream;
 #[path = "trace_faults.rs"]

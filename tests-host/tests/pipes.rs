@@ -103,6 +103,7 @@ fn every_subcommand_is_listed_here() {
         "bias",
         "events",
         "clipping",
+        "sprint",
         "rates",
         "running",
         "course",
@@ -137,13 +138,14 @@ fn output_into_a_closed_pipe_ends_by_sigpipe_without_a_panic() {
     std::fs::create_dir_all(&folder).unwrap();
     std::fs::copy(&demo, folder.join("walk.csv")).unwrap();
     let folder_arg = folder.to_str().unwrap().to_owned();
-    let runs: [&[&str]; 6] = [
+    let runs: [&[&str]; 7] = [
         &["eval", &folder_arg],
         &["replay", &demo],
         &["replay", &demo, "--json"],
         &["replay", &demo, "--detector", "stance", "--all-models"],
         &["energy", "--m4", "9000", "--m0", "24000"],
         &["replay", &demo, "--detector", "lu", "--model", "lu_fuzzy"],
+        &["sprint"],
     ];
     for args in runs {
         let (status, err) = closed(args);

@@ -218,6 +218,10 @@ enum Cmd {
         #[arg(default_value = "../../shared/datasets")]
         datasets: PathBuf,
     },
+    /// Simulate a sprint past the MPU6050's rails (40 g and 70 g touch-downs, toe-off beyond
+    /// 2 000 °/s), record it as the MPU6050 and as the LSM6DSV320X would, and compare the
+    /// strides with the truth (docs/sensors.md's table).
+    Sprint,
     /// Replay the datasets at their own rate and decimated to lower rates, and compare the
     /// strides.
     Rates {
@@ -924,6 +928,12 @@ fn run(cli: Cli) -> anyhow::Result<()> {
         }
         Cmd::Clipping { datasets } => {
             print!("{}", gaitclip_host::eval::clip_sweep::report(&datasets)?);
+        }
+        Cmd::Sprint => {
+            print!(
+                "{}",
+                gaitclip_host::eval::sprint_sim::report(std::path::Path::new("."))?
+            );
         }
         Cmd::Rates { datasets } => {
             print!("{}", gaitclip_host::eval::rate_sweep::report(&datasets)?);

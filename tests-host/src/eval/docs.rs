@@ -34,6 +34,7 @@ pub const GENERATORS: &[(&str, Generator)] = &[
     ("course", crate::eval::course::report),
     ("flags", crate::eval::flag_costs::report),
     ("bias", crate::eval::bias::report),
+    ("sprint", crate::eval::sprint_sim::report),
     ("json-fields", crate::replay::fields_report),
 ];
 

@@ -16,6 +16,7 @@ pub mod plot;
 pub mod rate_sweep;
 pub mod running;
 pub mod scoring;
+pub mod sprint_sim;
 pub mod stats;
 pub mod tables;
 pub mod wake_eval;
