@@ -5,7 +5,7 @@
 //! touch-down (tens of g) and toe-off (beyond 2 000 °/s), where the MPU6050 sits at both of
 //! its rails, stay in range.
 //!
-//! What this crate holds so far, each piece without a bus so that it is tested alone:
+//! What this crate holds, each piece tested alone:
 //!
 //! - [`range`]: the three channels' full-scale ranges, their register field values and their
 //!   sensitivities, as the seam's scales ([`gaitclip_imu::AccelScale`],
@@ -13,10 +13,30 @@
 //! - [`fifo`]: one FIFO word (a tag byte, then three little-endian words), and its tags;
 //! - [`merge`]: the two accelerometers merged into one unclipped specific force, in fixed
 //!   point ([`merge::DualRange`]), and the FIFO's words assembled into the pipeline's
-//!   [`gaitclip_imu::RawSample`]s at the low-g rate ([`merge::Assembler`]).
+//!   [`gaitclip_imu::RawSample`]s at the low-g rate ([`merge::Assembler`]);
+//! - the bus driver, [`blocking::Lsm6dsv320x`] and [`asynch::Lsm6dsv320x`].
 //!
-//! The bus driver (typestate modes, blocking and async, FIFO watermark, wake-up) is not here
-//! yet.
+//! ## The bus driver
+//!
+//! **Modes are types**, as in gaitclip's MPU6050 driver: fresh from `new` a driver is
+//! [`mode::Unconfigured`]; `init` (ST's reset procedure, then the ranges, the rates and the
+//! FIFO, from any mode) makes it [`mode::Sampling`], where the FIFO is read;
+//! `enter_motion_wake` makes it [`mode::MotionWake`] (the low-g accelerometer alone in
+//! low-power mode, INT1 latched on wake-up), where only the wake-up source can be read, and
+//! `leave_motion_wake` brings it back. A failed mode change hands the driver back in its old
+//! mode inside [`ModeChangeError`].
+//!
+//! **Written once.** Every configuration sequence is a `const fn` list of register steps
+//! ([`program`]); the driver that runs them and reads the FIFO is one async source from which
+//! `maybe-async-cfg` makes the blocking twin ([`blocking`], on [`embedded_hal::i2c::I2c`]) beside
+//! the async one ([`asynch`], on [`embedded_hal_async::i2c::I2c`]). `tests/bus.rs` spells out
+//! every transaction, from ST's register map, and runs each case on both.
+//!
+//! **One transfer per register or FIFO word**, so a bus error surfaces as [`Error::Bus`] and
+//! the caller decides whether to retry. A FIFO overrun empties the FIFO and is
+//! [`Error::FifoOverflow`]: the caller declares a gap.
+//!
+//! **No heap, no panics, no `unsafe`.** Capacities are the caller's slices.
 //!
 //! ## Sources
 //!
@@ -30,8 +50,18 @@
 #![forbid(unsafe_code)]
 #![deny(missing_docs)]
 
+mod bus;
+mod error;
 pub mod fifo;
 pub mod merge;
+pub mod mode;
+pub mod program;
 pub mod range;
+pub mod register;
+mod settings;
 
+pub use bus::{asynch, blocking};
+pub use error::{Error, ModeChangeError};
 pub use range::{AccelRange, GyroRange, HighGRange};
+pub use register::{FIFO_CAPACITY_WORDS, WHO_AM_I_VALUE};
+pub use settings::{Address, Config, FifoStatus, HighG, HighGOdr, MotionWakeConfig, Odr};

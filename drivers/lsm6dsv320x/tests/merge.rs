@@ -188,3 +188,24 @@ fn the_assembler_counts_what_it_cannot_pair() {
     assert_eq!(s.accel[0], 8_192);
     assert_eq!(a.high_g_missing(), 1);
 }
+
+#[test]
+fn rates_as_sts_codes_name_them() {
+    use gaitclip_lsm6dsv320x::{HighGOdr, Odr};
+    // DataRate: 0x2 = 7.5 Hz … 0x7 = 240 Hz … 0xC = 7 680 Hz; HgXlDataRate: 0x3 = 480 Hz …
+    // 0x7 = 7 680 Hz.
+    assert_eq!((Odr::Hz7_5.field(), Odr::Hz7_5.millihertz()), (0x2, 7_500));
+    assert_eq!(
+        (Odr::Hz240.field(), Odr::Hz240.millihertz()),
+        (0x7, 240_000)
+    );
+    assert_eq!(
+        (Odr::Hz7680.field(), Odr::Hz7680.millihertz()),
+        (0xC, 7_680_000)
+    );
+    assert_eq!((HighGOdr::Hz480.field(), HighGOdr::Hz480.hz()), (0x3, 480));
+    assert_eq!(
+        (HighGOdr::Hz7680.field(), HighGOdr::Hz7680.hz()),
+        (0x7, 7_680)
+    );
+}

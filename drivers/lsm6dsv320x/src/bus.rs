@@ -1,0 +1,211 @@
+//! The driver on the bus, written once: `maybe-async-cfg` makes [`blocking`] (on
+//! [`embedded_hal::i2c::I2c`]) and [`asynch`] (on [`embedded_hal_async::i2c::I2c`], for an
+//! executor that sleeps the core while a transfer runs) from the same source, so the two
+//! cannot drift apart.
+
+#[maybe_async_cfg::maybe(
+    idents(embedded_hal_async(sync = "embedded_hal", async)),
+    sync(self = "blocking"),
+    async(self = "asynch")
+)]
+/// The driver, `Lsm6dsv320x<I, Mode>` ([`crate::mode`]).
+pub mod driver {
+    use core::marker::PhantomData;
+
+    use embedded_hal_async::delay::DelayNs;
+    use embedded_hal_async::i2c::I2c;
+
+    use crate::error::{Error, ModeChangeError};
+    use crate::fifo::{FifoWord, WORD_BYTES};
+    use crate::mode::{Mode, MotionWake, Sampling, Unconfigured};
+    use crate::program::{self, Step};
+    use crate::register::{bits, reg, WHO_AM_I_VALUE};
+    use crate::settings::{Address, Config, FifoStatus, MotionWakeConfig};
+
+    /// An LSM6DSV320X on an I²C bus, in mode `M` ([`crate::mode`]).
+    #[derive(Debug)]
+    pub struct Lsm6dsv320x<I, M = Sampling> {
+        i2c: I,
+        address: u8,
+        mode: PhantomData<M>,
+    }
+
+    impl<I: I2c> Lsm6dsv320x<I, Unconfigured> {
+        /// Wraps the bus; talks to nothing yet.
+        pub const fn new(i2c: I, address: Address) -> Self {
+            Lsm6dsv320x {
+                i2c,
+                address: address.bits(),
+                mode: PhantomData,
+            }
+        }
+    }
+
+    impl<I: I2c, M: Mode> Lsm6dsv320x<I, M> {
+        /// Gives the bus back.
+        pub fn release(self) -> I {
+            self.i2c
+        }
+
+        /// The bus, for a board to recover it. The driver keeps no state about the bus, so
+        /// anything done to it is safe here.
+        pub fn bus_mut(&mut self) -> &mut I {
+            &mut self.i2c
+        }
+
+        /// Reads `WHO_AM_I`; [`Error::WrongDevice`] if it is not an LSM6DSV320X.
+        pub async fn probe(&mut self) -> Result<(), Error<I::Error>> {
+            match self.read_reg(reg::WHO_AM_I).await? {
+                WHO_AM_I_VALUE => Ok(()),
+                other => Err(Error::WrongDevice(other)),
+            }
+        }
+
+        /// From any mode: probes, resets and applies `config` ([`program::init`]), then turns
+        /// the FIFO on ([`program::enable_fifo`]). On failure the driver comes back in its
+        /// old mode.
+        #[allow(clippy::type_complexity)]
+        pub async fn init<D: DelayNs>(
+            mut self,
+            delay: &mut D,
+            config: &Config,
+        ) -> Result<Lsm6dsv320x<I, Sampling>, ModeChangeError<I::Error, Self>> {
+            let mut result = self.run(&program::init(config), delay).await;
+            if result.is_ok() {
+                result = self.run(&program::enable_fifo(config), delay).await;
+            }
+            match result {
+                Ok(()) => Ok(self.into_mode()),
+                Err(error) => Err(ModeChangeError { error, dev: self }),
+            }
+        }
+
+        /// Forgets the mode: the driver claims nothing about the part any more.
+        pub fn into_unconfigured(self) -> Lsm6dsv320x<I, Unconfigured> {
+            self.into_mode()
+        }
+
+        fn into_mode<N: Mode>(self) -> Lsm6dsv320x<I, N> {
+            Lsm6dsv320x {
+                i2c: self.i2c,
+                address: self.address,
+                mode: PhantomData,
+            }
+        }
+
+        async fn run<D: DelayNs>(
+            &mut self,
+            steps: &[Step],
+            delay: &mut D,
+        ) -> Result<(), Error<I::Error>> {
+            for step in steps {
+                match *step {
+                    Step::Identify => self.probe().await?,
+                    Step::Write { reg, value } => self.write_reg(reg, value).await?,
+                    Step::Check { reg, value } => {
+                        let read = self.read_reg(reg).await?;
+                        if read != value {
+                            return Err(Error::Verify(reg, value, read));
+                        }
+                    }
+                    Step::Read { reg } => {
+                        self.read_reg(reg).await?;
+                    }
+                    Step::WaitMs(ms) => delay.delay_ms(ms).await,
+                }
+            }
+            Ok(())
+        }
+
+        async fn read_reg(&mut self, r: u8) -> Result<u8, Error<I::Error>> {
+            let mut buf = [0u8];
+            self.i2c.write_read(self.address, &[r], &mut buf).await?;
+            Ok(buf[0])
+        }
+
+        async fn write_reg(&mut self, r: u8, value: u8) -> Result<(), Error<I::Error>> {
+            self.i2c.write(self.address, &[r, value]).await?;
+            Ok(())
+        }
+    }
+
+    impl<I: I2c> Lsm6dsv320x<I, Sampling> {
+        /// Reads `FIFO_STATUS1` and `FIFO_STATUS2` in one transfer.
+        pub async fn read_fifo_status(&mut self) -> Result<FifoStatus, Error<I::Error>> {
+            let mut b = [0u8; 2];
+            self.i2c
+                .write_read(self.address, &[reg::FIFO_STATUS1], &mut b)
+                .await?;
+            Ok(FifoStatus::from_bytes(b))
+        }
+
+        /// Reads one FIFO word: the tag and its six bytes in one transfer.
+        pub async fn read_fifo_word(&mut self) -> Result<FifoWord, Error<I::Error>> {
+            let mut b = [0u8; WORD_BYTES];
+            self.i2c
+                .write_read(self.address, &[reg::FIFO_DATA_OUT_TAG], &mut b)
+                .await?;
+            Ok(FifoWord::from_bytes(&b))
+        }
+
+        /// Reads the words waiting, up to `out.len()`, oldest first; how many. An overrun
+        /// empties the FIFO and is [`Error::FifoOverflow`] (the words in it are lost with the
+        /// overwritten ones: a gap).
+        pub async fn read_fifo(&mut self, out: &mut [FifoWord]) -> Result<usize, Error<I::Error>> {
+            let status = self.read_fifo_status().await?;
+            if status.overrun {
+                for step in &program::RESET_FIFO {
+                    if let Step::Write { reg, value } = *step {
+                        self.write_reg(reg, value).await?;
+                    }
+                }
+                return Err(Error::FifoOverflow);
+            }
+            let n = out.len().min(status.words as usize);
+            for slot in out.iter_mut().take(n) {
+                *slot = self.read_fifo_word().await?;
+            }
+            Ok(n)
+        }
+
+        /// Into the wait for motion ([`program::enter_motion_wake`]). On failure the driver
+        /// comes back sampling.
+        #[allow(clippy::type_complexity)]
+        pub async fn enter_motion_wake<D: DelayNs>(
+            mut self,
+            delay: &mut D,
+            wake: &MotionWakeConfig,
+        ) -> Result<Lsm6dsv320x<I, MotionWake>, ModeChangeError<I::Error, Self>> {
+            match self.run(&program::enter_motion_wake(wake), delay).await {
+                Ok(()) => Ok(self.into_mode()),
+                Err(error) => Err(ModeChangeError { error, dev: self }),
+            }
+        }
+    }
+
+    impl<I: I2c> Lsm6dsv320x<I, MotionWake> {
+        /// Reads `ALL_INT_SRC` (which clears the latch and releases INT1): whether the
+        /// wake-up fired.
+        pub async fn read_wake_source(&mut self) -> Result<bool, Error<I::Error>> {
+            Ok(self.read_reg(reg::ALL_INT_SRC).await? & bits::WU_IA != 0)
+        }
+
+        /// Back to sampling with `config` ([`program::leave_motion_wake`], then
+        /// [`program::enable_fifo`]). On failure the driver comes back waiting.
+        #[allow(clippy::type_complexity)]
+        pub async fn leave_motion_wake<D: DelayNs>(
+            mut self,
+            delay: &mut D,
+            config: &Config,
+        ) -> Result<Lsm6dsv320x<I, Sampling>, ModeChangeError<I::Error, Self>> {
+            let mut result = self.run(&program::leave_motion_wake(config), delay).await;
+            if result.is_ok() {
+                result = self.run(&program::enable_fifo(config), delay).await;
+            }
+            match result {
+                Ok(()) => Ok(self.into_mode()),
+                Err(error) => Err(ModeChangeError { error, dev: self }),
+            }
+        }
+    }
+}
