@@ -17,6 +17,17 @@ pub enum AccelRange {
 }
 
 impl AccelRange {
+    /// The range of an `FS_XL` field value.
+    pub const fn from_field(field: u8) -> Option<Self> {
+        match field {
+            0 => Some(AccelRange::G2),
+            1 => Some(AccelRange::G4),
+            2 => Some(AccelRange::G8),
+            3 => Some(AccelRange::G16),
+            _ => None,
+        }
+    }
+
     /// The `FS_XL` field value.
     pub const fn field(self) -> u8 {
         match self {
@@ -62,6 +73,18 @@ pub enum HighGRange {
 }
 
 impl HighGRange {
+    /// The range of an `FS_XL_HG` field value.
+    pub const fn from_field(field: u8) -> Option<Self> {
+        match field {
+            0 => Some(HighGRange::G32),
+            1 => Some(HighGRange::G64),
+            2 => Some(HighGRange::G128),
+            3 => Some(HighGRange::G256),
+            4 => Some(HighGRange::G320),
+            _ => None,
+        }
+    }
+
     /// The `FS_XL_HG` field value.
     pub const fn field(self) -> u8 {
         match self {
@@ -112,6 +135,18 @@ pub enum GyroRange {
 }
 
 impl GyroRange {
+    /// The range of an `FS_G` field value.
+    pub const fn from_field(field: u8) -> Option<Self> {
+        match field {
+            1 => Some(GyroRange::Dps250),
+            2 => Some(GyroRange::Dps500),
+            3 => Some(GyroRange::Dps1000),
+            4 => Some(GyroRange::Dps2000),
+            5 => Some(GyroRange::Dps4000),
+            _ => None,
+        }
+    }
+
     /// The `FS_G` field value.
     pub const fn field(self) -> u8 {
         match self {

@@ -67,6 +67,24 @@ impl Odr {
         }
     }
 
+    /// The rate of `hz` (7 for 7.5 Hz), if it is one.
+    pub const fn from_hz(hz: u32) -> Option<Self> {
+        match hz {
+            7 => Some(Odr::Hz7_5),
+            15 => Some(Odr::Hz15),
+            30 => Some(Odr::Hz30),
+            60 => Some(Odr::Hz60),
+            120 => Some(Odr::Hz120),
+            240 => Some(Odr::Hz240),
+            480 => Some(Odr::Hz480),
+            960 => Some(Odr::Hz960),
+            1920 => Some(Odr::Hz1920),
+            3840 => Some(Odr::Hz3840),
+            7680 => Some(Odr::Hz7680),
+            _ => None,
+        }
+    }
+
     /// The rate, mHz (7.5 Hz doubles from 15 Hz upward).
     pub const fn millihertz(self) -> u32 {
         7_500 << (self.field() - 2)
@@ -103,6 +121,18 @@ impl HighGOdr {
     /// The rate, Hz.
     pub const fn hz(self) -> u32 {
         480 << (self.field() - 3)
+    }
+
+    /// The rate of `hz`, if it is one.
+    pub const fn from_hz(hz: u32) -> Option<Self> {
+        match hz {
+            480 => Some(HighGOdr::Hz480),
+            960 => Some(HighGOdr::Hz960),
+            1920 => Some(HighGOdr::Hz1920),
+            3840 => Some(HighGOdr::Hz3840),
+            7680 => Some(HighGOdr::Hz7680),
+            _ => None,
+        }
     }
 }
 

@@ -208,4 +208,32 @@ fn rates_as_sts_codes_name_them() {
         (HighGOdr::Hz7680.field(), HighGOdr::Hz7680.hz()),
         (0x7, 7_680)
     );
+    for odr in [Odr::Hz15, Odr::Hz240, Odr::Hz7680] {
+        assert_eq!(Odr::from_hz(odr.millihertz() / 1000), Some(odr));
+    }
+    assert_eq!(Odr::from_hz(7), Some(Odr::Hz7_5));
+    assert_eq!(Odr::from_hz(200), None);
+    assert_eq!(HighGOdr::from_hz(960), Some(HighGOdr::Hz960));
+    assert_eq!(HighGOdr::from_hz(240), None);
+}
+
+#[test]
+fn field_values_name_their_ranges_back() {
+    for r in [
+        AccelRange::G2,
+        AccelRange::G4,
+        AccelRange::G8,
+        AccelRange::G16,
+    ] {
+        assert_eq!(AccelRange::from_field(r.field()), Some(r));
+    }
+    for r in HIGH {
+        assert_eq!(HighGRange::from_field(r.field()), Some(r));
+    }
+    for f in 1..=5 {
+        assert_eq!(GyroRange::from_field(f).map(GyroRange::field), Some(f));
+    }
+    assert_eq!(AccelRange::from_field(4), None);
+    assert_eq!(HighGRange::from_field(5), None);
+    assert_eq!(GyroRange::from_field(0), None);
 }

@@ -40,67 +40,13 @@ use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
 
 use crate::eval::markdown::{cm_cell, Column, ErrorStats, Table};
-use crate::io::trace::{quantize, ImuSample, G_MPS2};
+use crate::io::trace::{quantize, G_MPS2};
 use crate::replay::core_strides;
-use crate::sim::gait_sim::{Scenario, Segment, Trajectory, Vigour};
-
-/// A sprinting stride: 3.8 m in 0.54 s (7 m/s), 0.12 s of it on the ground.
-pub const SPRINT_LENGTH_M: f64 = 3.8;
-/// Its stance, s.
-pub const SPRINT_STANCE_S: f64 = 0.12;
-/// Its movement, heel-off to foot-flat, s.
-pub const SPRINT_MOVEMENT_S: f64 = 0.42;
-
-/// A sprint's vigour with touch-down at `touch_down_g` (the dip's peak specific force above
-/// the motion's own): a 25 ms dip, and a 35 ms toe-off snap of 26° (±2 300 °/s on top of
-/// the swing's own rotation).
-pub fn sprint_vigour(touch_down_g: f64) -> Vigour {
-    let dip_s = 0.025;
-    let k = (std::f64::consts::PI / dip_s).powi(2);
-    Vigour {
-        impact_g: 0.0,
-        clearance_m: 0.30,
-        pitch_rad: 0.9,
-        dip_m: touch_down_g * G_MPS2 / (4.0 * k),
-        dip_s,
-        snap_rad: 26f64.to_radians(),
-        snap_s: 0.035,
-    }
-}
-
-/// The simulated sprints: stand, two strides to speed, twelve sprint strides, two to stop,
-/// stand; touch-down at 40 g and at 70 g.
-pub fn scenarios() -> Vec<Scenario> {
-    let stride = |strides, length_m, stance_s, movement_s, flag| Segment::Walk {
-        strides,
-        length_m,
-        stance_s,
-        movement_s,
-        turn_deg: 0.0,
-        flag,
-    };
-    [(40.0, "sprint_40g", 11), (70.0, "sprint_70g", 12)]
-        .into_iter()
-        .map(|(g, name, seed)| Scenario {
-            name,
-            description:
-                "a sprint: clip on the laces, two strides to speed, twelve at 7 m/s, two to stop",
-            rate_hz: 960.0,
-            mounting_deg: [5.0, -10.0, 0.0],
-            seed,
-            vigour: sprint_vigour(g),
-            segments: vec![
-                Segment::Stand(2.0),
-                stride(1, 1.6, 0.3, 0.5, "first"),
-                stride(1, 2.8, 0.18, 0.45, "speeding"),
-                stride(12, SPRINT_LENGTH_M, SPRINT_STANCE_S, SPRINT_MOVEMENT_S, ""),
-                stride(1, 2.4, 0.18, 0.45, "slowing"),
-                stride(1, 1.0, 0.3, 0.5, "last"),
-                Segment::Stand(2.0),
-            ],
-        })
-        .collect()
-}
+use crate::sim::gait_sim::{Scenario, Trajectory};
+use crate::sim::sprint::lsm_fifo;
+pub use crate::sim::sprint::{
+    scenarios, sprint_vigour, SPRINT_LENGTH_M, SPRINT_MOVEMENT_S, SPRINT_STANCE_S,
+};
 
 /// How a part records the motion.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -244,42 +190,26 @@ pub fn record(sc: &Scenario, rec: Recording) -> Recorded {
         }
         Recording::Merged => {
             let dual = rec.dual();
-            let low_k = accel_counts_per_mps2(StAccel::G16.scale());
-            let high_k = accel_counts_per_mps2(HighGRange::G128.scale());
-            // High-g samples per low-g period.
-            const PER: usize = 4;
+            let fifo = lsm_fifo(sc);
             let mut asm = Assembler::new(dual);
-            for i in 0..n {
-                let t = i as f64 / rate;
-                let slot = (i % 4) as u8;
-                let word = |tag, data| FifoWord { tag, slot, data };
-                // The high-g samples of the period (t − 1/rate, t], oldest first.
-                let highs: Vec<ImuSample> = (0..PER)
-                    .rev()
-                    .map(|j| tr.sample(t - j as f64 / (rate * PER as f64), &mut rng))
-                    .collect();
-                let low = tr.sample(t, &mut rng);
-                let low_counts = counts(low.acc_mps2, low_k);
-                let gyro = counts(low.gyr_radps, g_k);
-                let before = RawSample {
-                    accel: low_counts,
-                    gyro,
-                    temp: 0,
-                };
-                out.accel_railed +=
-                    (0..3).any(|k| (low_counts[k] as i32).abs() >= dual.rail_counts()) as usize;
-                out.gyro_railed += low_rails.gyro_clipped(&before) as usize;
-                let mut words: Vec<FifoWord> = highs
-                    .iter()
-                    .map(|h| word(Tag::HighG, counts(h.acc_mps2, high_k)))
-                    .collect();
-                words.push(word(Tag::Accel, low_counts));
-                words.push(word(Tag::Gyro, gyro));
-                for w in words {
-                    // Each word round-trips through its 7 bytes, as the FIFO delivers it.
-                    let w = FifoWord::from_bytes(&w.to_bytes());
-                    out.samples.extend(asm.push(w));
+            for (w, raw) in fifo.words.iter().zip(&fifo.low_g_counts) {
+                if w.tag == Tag::Accel {
+                    out.accel_railed +=
+                        raw.iter().any(|&v| (v as i32).abs() >= dual.rail_counts()) as usize;
                 }
+            }
+            for w in &fifo.words {
+                // Each word round-trips through its 7 bytes, as the FIFO delivers it.
+                let w = FifoWord::from_bytes(&w.to_bytes());
+                if w.tag == Tag::Gyro {
+                    let s = RawSample {
+                        accel: [0; 3],
+                        gyro: w.data,
+                        temp: 0,
+                    };
+                    out.gyro_railed += low_rails.gyro_clipped(&s) as usize;
+                }
+                out.samples.extend(asm.push(w));
             }
             out.samples.extend(asm.flush());
             out.high_g_axes = asm.high_g_axes();

@@ -2,3 +2,4 @@
 
 pub mod fixtures;
 pub mod gait_sim;
+pub mod sprint;
