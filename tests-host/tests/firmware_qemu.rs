@@ -179,6 +179,89 @@ fn qemu_m0_peak_valley_steps_equal_host_replay() {
     );
 }
 
+/// The second part end to end: the M4 firmware built with `replay-lsm6dsv320x` replays the
+/// stored sprint as the LSM6DSV320X's FIFO delivers it (`fixtures/sprint_40g.lsm6dsv320x`:
+/// the emulated part's FIFO filled period by period, read at its watermark by the real driver,
+/// the two accelerometers merged on the board) and logs the same per-stride integers as the
+/// host: the same words through the same merge and the pipeline at the part's scales.
+#[test]
+fn qemu_m4_lsm6dsv320x_sprint_equals_host_replay() {
+    use gaitclip_host::sim::sprint::{LSM_ACCEL, LSM_GYRO, LSM_HIGH_G, LSM_RATE_HZ};
+    use gaitclip_lsm6dsv320x::merge::{Assembler, DualRange};
+    if !qemu::available_or_skip() {
+        return;
+    }
+    let env = [("CARGO_TARGET_DIR", "target/replay-lsm6dsv320x".as_ref())];
+    let elf = firmware::build_with(
+        "boards/mps2-an386",
+        "mps2-an386",
+        "thumbv7em-none-eabihf",
+        &["--features", "replay-lsm6dsv320x"],
+        &env,
+    )
+    .expect("firmware builds");
+    let (out, on_target) = run_to_exit(&elf, qemu::MACHINE_M4);
+
+    let words = gaitclip_host::sim::fixtures::firmware_lsm_trace_words().unwrap();
+    let dual = DualRange::new(LSM_ACCEL, LSM_HIGH_G);
+    let mut assembler = Assembler::new(dual);
+    let mut counts: Vec<RawSample> = words.iter().filter_map(|w| assembler.push(*w)).collect();
+    counts.extend(assembler.flush());
+    let mut config = Config::new(
+        SampleRate::from_hz(LSM_RATE_HZ).unwrap(),
+        dual.scale(),
+        LSM_GYRO.scale(),
+    );
+    config.detector = Detector::Cycle;
+    const M: usize = gaitclip::detect::seam::movement_samples(LSM_RATE_HZ);
+    let mut pipeline =
+        gaitclip::pipeline::Pipeline::<gaitclip::pipeline::detectors::AnyDetector<M>>::sized(
+            config,
+        );
+    let mut host: Vec<LoggedStride> = counts
+        .iter()
+        .filter_map(|s| pipeline.process(s))
+        .map(|s| LoggedStride::of(&s))
+        .collect();
+    host.extend(std::iter::from_fn(|| pipeline.finish()).map(|s| LoggedStride::of(&s)));
+    // The sprint's sixteen strides, all found.
+    assert_eq!(host.len(), 16, "{host:#?}");
+    assert_eq!(on_target, host);
+
+    let line = |prefix: &str| {
+        out.lines
+            .iter()
+            .find(|l| l.starts_with(prefix))
+            .unwrap_or_else(|| panic!("no `{prefix}` line:\n{}", out.lines.join("\n")))
+            .clone()
+    };
+    let summary = line("summary");
+    for want in [
+        format!("strides={}", host.len()),
+        format!("samples={}", counts.len()),
+        "overruns=0".into(),
+        "bus_errors=0".into(),
+        "fifo_overflows=0".into(),
+        "lost_samples=0".into(),
+        // Nothing at a rail: the merged counts reach ±128 g, the gyroscope ±4 000 °/s.
+        "clipped=0,0,0,0,0,0".into(),
+    ] {
+        assert!(summary.contains(&want), "{want}: {summary}");
+    }
+    // The board's merge took as many axes from the high-g channel as the host's, every
+    // railed axis had high-g samples, every time slot had both words.
+    assert!(assembler.high_g_axes() > 0);
+    assert_eq!(
+        line("merge"),
+        format!(
+            "merge high_g_axes={} high_g_missing=0 unpaired=0 high_g_dropped=0",
+            assembler.high_g_axes()
+        )
+    );
+    // docs/sensors.md's transcript is this run's.
+    transcript_printed("docs/sensors.md", "On the emulated board", &out.lines);
+}
+
 /// The firmware's strides against the host's replay with the same movement buffer of `M`
 /// samples (the micro:bit keeps fewer than the host: a stride whose movement overflows it is
 /// split on what it kept, on both).

@@ -15,11 +15,13 @@
 //!   with the `ble` feature `rsc_gatt`, its GATT server on trouble-host.
 //! - [`replay_mpu6050`], [`replay_holes`] and [`replay_still`]: an MPU6050 on an emulated
 //!   I²C bus serving a stored trace (losing samples, standing still, sleeping in its cycle
-//!   mode), for the QEMU boards and the host tests.
+//!   mode), for the QEMU boards and the host tests; [`replay_lsm6dsv320x`]: an LSM6DSV320X
+//!   serving a stored FIFO the same way.
 //! - On a Cortex-M only: `live_app` (the main loop of a board with a real sensor),
 //!   `stride_log` (defmt and the serial line), `registers` (memory-mapped peripherals),
 //!   and with the `replay` feature
-//!   `replay_app` (the QEMU firmware) and `stack_paint` (the stack's high-water mark).
+//!   `replay_app` (the QEMU firmware) and `stack_paint` (the stack's high-water mark), and
+//!   with `replay-lsm6dsv320x` `replay_lsm_app` (the QEMU firmware on the LSM6DSV320X).
 //!
 //! The parts above `live_app` build on the host, where `tests-host` checks them against
 //! mocked buses.
@@ -49,6 +51,7 @@ pub const DETECTOR: Detector = if cfg!(feature = "peak-valley-detector") {
 pub mod imu_sampler;
 pub mod live_settings;
 pub mod replay_holes;
+pub mod replay_lsm6dsv320x;
 pub mod replay_mpu6050;
 pub mod replay_still;
 pub mod rsc;
@@ -64,6 +67,8 @@ pub mod live_app;
 pub mod registers;
 #[cfg(all(target_os = "none", feature = "replay"))]
 pub mod replay_app;
+#[cfg(all(target_os = "none", feature = "replay-lsm6dsv320x"))]
+pub mod replay_lsm_app;
 #[cfg(all(target_os = "none", feature = "paint-stack"))]
 pub mod stack_paint;
 #[cfg(target_os = "none")]
