@@ -18,12 +18,13 @@
 //! eldruin's drivers do; the part may then be half-way, which [`init`](blocking::Mpu6050::init)
 //! always cures.
 //!
-//! **One register program, two ways to run it.** Every configuration sequence is a list of
-//! register steps built by a `const fn` ([`program`]); the blocking driver ([`blocking`], on
-//! [`embedded_hal::i2c::I2c`]) and the async one ([`asynch`], on
-//! [`embedded_hal_async::i2c::I2c`], for an executor that sleeps the core while the transfer
-//! runs) both only execute those steps and the reads, so they cannot drift apart; the tests
-//! check both against the same bus transactions.
+//! **One register program, one driver source, two ways to run it.** Every configuration
+//! sequence is a list of register steps built by a `const fn` ([`program`]); the driver that
+//! executes them and the reads is written once, async, and `maybe-async-cfg` makes the
+//! blocking driver ([`blocking`], on [`embedded_hal::i2c::I2c`]) from it beside the async one
+//! ([`asynch`], on [`embedded_hal_async::i2c::I2c`], for an executor that sleeps the core
+//! while the transfer runs), so they cannot drift apart; the tests check both against the
+//! same bus transactions.
 //!
 //! **Every register access is one `write` or `write_read`**, so a bus error surfaces as
 //! [`Error::Bus`] and the caller decides whether to retry. The driver keeps no state about
@@ -54,8 +55,7 @@
 #![forbid(unsafe_code)]
 #![deny(missing_docs)]
 
-pub mod asynch;
-pub mod blocking;
+mod bus;
 mod error;
 pub mod mode;
 pub mod program;
@@ -64,6 +64,7 @@ pub mod register;
 pub mod sample;
 mod settings;
 
+pub use bus::{asynch, blocking};
 pub use error::{Error, ModeChangeError};
 pub use gaitclip_imu::{AccelScale, GyroScale, RawSample};
 pub use range::{AccelRange, GyroRange};

@@ -26,9 +26,10 @@
 //!
 //! Board glue, shared: generic over the bus and delay.
 
-pub mod asynch;
-pub mod blocking;
 mod ledger;
+mod sampler;
+
+pub use sampler::{asynch, blocking};
 
 pub use blocking::ImuSampler;
 
