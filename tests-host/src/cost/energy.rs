@@ -338,6 +338,74 @@ pub fn savings(insn_per_sample: f64) -> Vec<Saving> {
 
 /// The budget tables in Markdown, for docs/energy.md: the nRF52840 builds at `m4_insn` and the
 /// Pico at `m0_insn` instructions per sample of walking (strides included).
+/// How much a sensor may draw for `hours_of_use` on `mah` at one hour of walking a day, on
+/// `board` with its own sensor's rows (`sensor_walking`, `sensor_still`) taken out: the
+/// largest walking current, µA, with the sensor's still current at `sensor_still_ua`
+/// (negative: the rest of the board alone spends more than the battery gives).
+pub fn sensor_allowance_ua(
+    board: &Budget,
+    sensor_rows: (&str, &str),
+    mah: f64,
+    hours_of_use: f64,
+    sensor_still_ua: f64,
+) -> f64 {
+    let without = |parts: &[(&str, f64)], name: &str| -> f64 {
+        parts.iter().filter(|p| p.0 != name).map(|p| p.1).sum()
+    };
+    let other_walking = without(&board.walking, sensor_rows.0);
+    let other_still = without(&board.still, sensor_rows.1);
+    // One hour of walking a day: `hours_of_use` days, each 1 h walking and 23 h still.
+    let per_day_uah = mah * 1000.0 / hours_of_use;
+    per_day_uah - other_walking - 23.0 * (other_still + sensor_still_ua)
+}
+
+/// Hours of use (at one hour of walking a day) on `mah` of the sensor alone, walking at
+/// `walking_ua` and still at `still_ua`: the physical floor no MCU work can lower.
+pub fn sensor_floor_hours(mah: f64, walking_ua: f64, still_ua: f64) -> f64 {
+    mah * 1000.0 / (walking_ua + 23.0 * still_ua)
+}
+
+/// The hours of use a second sensor is judged by (issue 47), and a commercial foot pod's.
+pub const HOURS_OF_USE_TARGETS: [f64; 2] = [250.0, 400.0];
+/// Still currents of a sensor's wake-up mode the allowance is given for, µA.
+pub const SENSOR_STILL_UA: [f64; 3] = [5.0, 10.0, 20.0];
+
+fn allowance_section(o: &mut String, ble: &Budget) {
+    let (mah_name, mah) = BATTERIES[0];
+    let cycle = mpu6050_cycle(SLEEP.wake.rate).ua;
+    let _ = writeln!(
+        o,
+        "\nThe sensor's share on the Bluetooth build, {mah_name}, one hour of walking a day. The floor: the MPU6050 alone (MCU and radio drawing nothing) gives {:.0} hours of use ({:.0} µA walking, {cycle} µA still). What any sensor may draw for a number of hours of use, the rest of the board as above (walking {:.1} µA, still {:.1} µA without the sensor):\n",
+        sensor_floor_hours(mah, MPU6050_SAMPLING.ua, cycle),
+        MPU6050_SAMPLING.ua,
+        ble.walking_ua() - MPU6050_SAMPLING.ua,
+        ble.still_ua() - cycle,
+    );
+    let mut t = Table::new(
+        std::iter::once(Column::from("hours of use"))
+            .chain(
+                SENSOR_STILL_UA
+                    .iter()
+                    .map(|s| Column::right(format!("sensor walking µA, still at {s} µA"))),
+            )
+            .collect::<Vec<_>>(),
+    );
+    for h in HOURS_OF_USE_TARGETS {
+        t.row(
+            std::iter::once(format!("{h:.0}")).chain(SENSOR_STILL_UA.iter().map(|&s| {
+                let ua =
+                    sensor_allowance_ua(ble, ("MPU6050 sampling", "MPU6050 cycle mode"), mah, h, s);
+                if ua >= 0.0 {
+                    format!("{ua:.0}")
+                } else {
+                    format!("none (the rest is {:.0} over)", -ua)
+                }
+            })),
+        );
+    }
+    o.push_str(&t.render());
+}
+
 pub fn report(m4_insn: f64, m0_insn: f64) -> String {
     let boards = [
         nrf52840(m4_insn, 1.0),
@@ -406,6 +474,7 @@ pub fn report(m4_insn: f64, m0_insn: f64) -> String {
         }
     }
     o.push_str(&life.render());
+    allowance_section(&mut o, &boards[1]);
     let _ = writeln!(
         o,
         "\nA CR2032's 225 mAh is rated at a light drain; at the 4 mA of walking its usable capacity is lower (not modelled).\n"
@@ -453,6 +522,26 @@ pub fn report(m4_insn: f64, m0_insn: f64) -> String {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn the_sensor_allowance_gives_back_the_hours_it_was_asked_for() {
+        let ble = nrf52840_ble(9600.0, 1.0);
+        let rows = ("MPU6050 sampling", "MPU6050 cycle mode");
+        // Put a sensor drawing exactly the allowance in the MPU6050's place: the budget then
+        // lasts the hours asked for.
+        for hours in HOURS_OF_USE_TARGETS {
+            let still = 10.0;
+            let walking = sensor_allowance_ua(&ble, rows, 225.0, hours, still);
+            let mut b = ble.clone();
+            b.walking[0] = ("sensor", walking);
+            let cycle = b.still.iter().position(|p| p.0 == rows.1).unwrap();
+            b.still[cycle] = ("sensor", still);
+            assert!((b.days_of_use(225.0, 1.0) - hours).abs() < 1e-9, "{hours}");
+        }
+        // The MPU6050's own floor: 225 mAh over 3.8 mA for an hour and 20 µA for 23.
+        let floor = sensor_floor_hours(225.0, 3800.0, 20.0);
+        assert!((floor - 225_000.0 / (3800.0 + 460.0)).abs() < 1e-9);
+    }
 
     #[test]
     fn a_fifo_burst_of_eight_is_1335_bits() {
