@@ -4,7 +4,10 @@
 //! cannot drift apart.
 
 #[maybe_async_cfg::maybe(
-    idents(embedded_hal_async(sync = "embedded_hal", async)),
+    idents(
+        embedded_hal_async(sync = "embedded_hal", async),
+        asynch(sync = "blocking", async)
+    ),
     sync(self = "blocking"),
     async(self = "asynch")
 )]
@@ -15,6 +18,9 @@ pub mod driver {
     use embedded_hal_async::delay::DelayNs;
     use embedded_hal_async::i2c::I2c;
 
+    use gaitclip_regbus::asynch::RegisterBus;
+    use gaitclip_regbus::Identity;
+
     use crate::error::{Error, ModeChangeError};
     use crate::fifo::{FifoWord, WORD_BYTES};
     use crate::mode::{Mode, MotionWake, Sampling, Unconfigured};
@@ -22,11 +28,16 @@ pub mod driver {
     use crate::register::{bits, reg, WHO_AM_I_VALUE};
     use crate::settings::{Address, Config, FifoStatus, MotionWakeConfig};
 
+    /// What `WHO_AM_I` holds on this part.
+    const IDENTITY: Identity = Identity {
+        reg: reg::WHO_AM_I,
+        value: WHO_AM_I_VALUE,
+    };
+
     /// An LSM6DSV320X on an I²C bus, in mode `M` ([`crate::mode`]).
     #[derive(Debug)]
     pub struct Lsm6dsv320x<I, M = Sampling> {
-        i2c: I,
-        address: u8,
+        bus: RegisterBus<I>,
         mode: PhantomData<M>,
     }
 
@@ -34,8 +45,7 @@ pub mod driver {
         /// Wraps the bus; talks to nothing yet.
         pub const fn new(i2c: I, address: Address) -> Self {
             Lsm6dsv320x {
-                i2c,
-                address: address.bits(),
+                bus: RegisterBus::new(i2c, address.bits()),
                 mode: PhantomData,
             }
         }
@@ -44,21 +54,18 @@ pub mod driver {
     impl<I: I2c, M: Mode> Lsm6dsv320x<I, M> {
         /// Gives the bus back.
         pub fn release(self) -> I {
-            self.i2c
+            self.bus.release()
         }
 
         /// The bus, for a board to recover it. The driver keeps no state about the bus, so
         /// anything done to it is safe here.
         pub fn bus_mut(&mut self) -> &mut I {
-            &mut self.i2c
+            self.bus.bus_mut()
         }
 
         /// Reads `WHO_AM_I`; [`Error::WrongDevice`] if it is not an LSM6DSV320X.
         pub async fn probe(&mut self) -> Result<(), Error<I::Error>> {
-            match self.read_reg(reg::WHO_AM_I).await? {
-                WHO_AM_I_VALUE => Ok(()),
-                other => Err(Error::WrongDevice(other)),
-            }
+            Ok(self.bus.identify(IDENTITY).await?)
         }
 
         /// From any mode: probes, resets and applies `config` ([`program::init`]), then turns
@@ -87,8 +94,7 @@ pub mod driver {
 
         fn into_mode<N: Mode>(self) -> Lsm6dsv320x<I, N> {
             Lsm6dsv320x {
-                i2c: self.i2c,
-                address: self.address,
+                bus: self.bus,
                 mode: PhantomData,
             }
         }
@@ -98,34 +104,7 @@ pub mod driver {
             steps: &[Step],
             delay: &mut D,
         ) -> Result<(), Error<I::Error>> {
-            for step in steps {
-                match *step {
-                    Step::Identify => self.probe().await?,
-                    Step::Write { reg, value } => self.write_reg(reg, value).await?,
-                    Step::Check { reg, value } => {
-                        let read = self.read_reg(reg).await?;
-                        if read != value {
-                            return Err(Error::Verify(reg, value, read));
-                        }
-                    }
-                    Step::Read { reg } => {
-                        self.read_reg(reg).await?;
-                    }
-                    Step::WaitMs(ms) => delay.delay_ms(ms).await,
-                }
-            }
-            Ok(())
-        }
-
-        async fn read_reg(&mut self, r: u8) -> Result<u8, Error<I::Error>> {
-            let mut buf = [0u8];
-            self.i2c.write_read(self.address, &[r], &mut buf).await?;
-            Ok(buf[0])
-        }
-
-        async fn write_reg(&mut self, r: u8, value: u8) -> Result<(), Error<I::Error>> {
-            self.i2c.write(self.address, &[r, value]).await?;
-            Ok(())
+            Ok(self.bus.run(steps, delay, IDENTITY).await?)
         }
     }
 
@@ -133,18 +112,14 @@ pub mod driver {
         /// Reads `FIFO_STATUS1` and `FIFO_STATUS2` in one transfer.
         pub async fn read_fifo_status(&mut self) -> Result<FifoStatus, Error<I::Error>> {
             let mut b = [0u8; 2];
-            self.i2c
-                .write_read(self.address, &[reg::FIFO_STATUS1], &mut b)
-                .await?;
+            self.bus.read(reg::FIFO_STATUS1, &mut b).await?;
             Ok(FifoStatus::from_bytes(b))
         }
 
         /// Reads one FIFO word: the tag and its six bytes in one transfer.
         pub async fn read_fifo_word(&mut self) -> Result<FifoWord, Error<I::Error>> {
             let mut b = [0u8; WORD_BYTES];
-            self.i2c
-                .write_read(self.address, &[reg::FIFO_DATA_OUT_TAG], &mut b)
-                .await?;
+            self.bus.read(reg::FIFO_DATA_OUT_TAG, &mut b).await?;
             Ok(FifoWord::from_bytes(&b))
         }
 
@@ -154,11 +129,9 @@ pub mod driver {
         pub async fn read_fifo(&mut self, out: &mut [FifoWord]) -> Result<usize, Error<I::Error>> {
             let status = self.read_fifo_status().await?;
             if status.overrun {
-                for step in &program::RESET_FIFO {
-                    if let Step::Write { reg, value } = *step {
-                        self.write_reg(reg, value).await?;
-                    }
-                }
+                self.bus
+                    .run(&program::RESET_FIFO, &mut gaitclip_regbus::NoWait, IDENTITY)
+                    .await?;
                 return Err(Error::FifoOverflow);
             }
             let n = out.len().min(status.words as usize);
@@ -187,7 +160,7 @@ pub mod driver {
         /// Reads `ALL_INT_SRC` (which clears the latch and releases INT1): whether the
         /// wake-up fired.
         pub async fn read_wake_source(&mut self) -> Result<bool, Error<I::Error>> {
-            Ok(self.read_reg(reg::ALL_INT_SRC).await? & bits::WU_IA != 0)
+            Ok(self.bus.read_reg(reg::ALL_INT_SRC).await? & bits::WU_IA != 0)
         }
 
         /// Back to sampling with `config` ([`program::leave_motion_wake`], then

@@ -21,19 +21,15 @@ impl<E> From<E> for Error<E> {
     }
 }
 
-/// A mode change that failed: why, and the driver back in the mode it was in, to retry the
-/// change or reset the part with `init` (the part itself may be half-way between the two).
-pub struct ModeChangeError<E, D> {
-    /// What failed.
-    pub error: Error<E>,
-    /// The driver, in its old mode.
-    pub dev: D,
-}
-
-impl<E: core::fmt::Debug, D> core::fmt::Debug for ModeChangeError<E, D> {
-    fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
-        f.debug_struct("ModeChangeError")
-            .field("error", &self.error)
-            .finish_non_exhaustive()
+impl<E> From<gaitclip_regbus::ProgramError<E>> for Error<E> {
+    fn from(e: gaitclip_regbus::ProgramError<E>) -> Self {
+        match e {
+            gaitclip_regbus::ProgramError::Bus(e) => Error::Bus(e),
+            gaitclip_regbus::ProgramError::WrongDevice(v) => Error::WrongDevice(v),
+            gaitclip_regbus::ProgramError::Verify(r, w, v) => Error::Verify(r, w, v),
+        }
     }
 }
+
+/// A mode change that failed: the driver's error, and the driver back in its old mode.
+pub type ModeChangeError<E, D> = gaitclip_regbus::ModeChangeError<Error<E>, D>;

@@ -54,7 +54,6 @@ mod bus;
 mod error;
 pub mod fifo;
 pub mod merge;
-pub mod mode;
 pub mod program;
 pub mod range;
 pub mod register;
@@ -62,6 +61,8 @@ mod settings;
 
 pub use bus::{asynch, blocking};
 pub use error::{Error, ModeChangeError};
+/// The driver's modes, as types (shared by gaitclip's drivers).
+pub use gaitclip_regbus::mode;
 pub use range::{AccelRange, GyroRange, HighGRange};
 pub use register::{FIFO_CAPACITY_WORDS, WHO_AM_I_VALUE};
 pub use settings::{Address, Config, FifoStatus, HighG, HighGOdr, MotionWakeConfig, Odr};

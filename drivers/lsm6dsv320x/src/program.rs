@@ -5,34 +5,7 @@
 use crate::register::{bits, reg, RESET_WAIT_MS};
 use crate::settings::{Config, MotionWakeConfig};
 
-/// One step of a register program.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum Step {
-    /// Read `WHO_AM_I`: anything but [`crate::WHO_AM_I_VALUE`] is
-    /// [`crate::Error::WrongDevice`] and ends the program.
-    Identify,
-    /// Write `value` to `reg`.
-    Write {
-        /// Register.
-        reg: u8,
-        /// Value.
-        value: u8,
-    },
-    /// Read `reg` back: anything but `value` is [`crate::Error::Verify`] and ends the program.
-    Check {
-        /// Register.
-        reg: u8,
-        /// The value it must hold.
-        value: u8,
-    },
-    /// Read `reg` and drop the value (reading `ALL_INT_SRC` clears latched interrupts).
-    Read {
-        /// Register.
-        reg: u8,
-    },
-    /// Wait this long, ms.
-    WaitMs(u32),
-}
+pub use gaitclip_regbus::Step;
 
 const fn w(reg: u8, value: u8) -> Step {
     Step::Write { reg, value }

@@ -5,7 +5,10 @@
 //! programs, the same reads.
 
 #[maybe_async_cfg::maybe(
-    idents(embedded_hal_async(sync = "embedded_hal", async)),
+    idents(
+        embedded_hal_async(sync = "embedded_hal", async),
+        asynch(sync = "blocking", async)
+    ),
     sync(self = "blocking"),
     async(self = "asynch")
 )]
@@ -16,7 +19,9 @@ pub mod driver {
     use embedded_hal_async::delay::DelayNs;
     use embedded_hal_async::i2c::I2c;
 
-    use super::NoWait;
+    use gaitclip_regbus::asynch::RegisterBus;
+    use gaitclip_regbus::{Identity, NoWait};
+
     use crate::error::{Error, ModeChangeError};
     use crate::mode::{Mode, MotionWake, Sampling, Unconfigured};
     use crate::program::{self, FifoCount, Step};
@@ -25,11 +30,16 @@ pub mod driver {
     use crate::settings::{Address, Config, InterruptStatus, MotionWakeConfig};
     use crate::AccelRange;
 
+    /// What `WHO_AM_I` holds on this part.
+    const IDENTITY: Identity = Identity {
+        reg: reg::WHO_AM_I,
+        value: WHO_AM_I_VALUE,
+    };
+
     /// An MPU6050 on an I²C bus, in mode `M` ([`crate::mode`]).
     #[derive(Debug)]
     pub struct Mpu6050<I, M = Sampling> {
-        i2c: I,
-        address: u8,
+        bus: RegisterBus<I>,
         mode: PhantomData<M>,
     }
 
@@ -37,8 +47,7 @@ pub mod driver {
         /// Wraps the bus; talks to nothing yet.
         pub const fn new(i2c: I, address: Address) -> Self {
             Mpu6050 {
-                i2c,
-                address: address.bits(),
+                bus: RegisterBus::new(i2c, address.bits()),
                 mode: PhantomData,
             }
         }
@@ -47,26 +56,23 @@ pub mod driver {
     impl<I: I2c, M: Mode> Mpu6050<I, M> {
         /// Gives the bus back.
         pub fn release(self) -> I {
-            self.i2c
+            self.bus.release()
         }
 
         /// The bus, for a board to recover it (clock SCL until a stuck slave lets go of SDA).
         /// The driver keeps no state about the bus, so anything done to it is safe here.
         pub fn bus_mut(&mut self) -> &mut I {
-            &mut self.i2c
+            self.bus.bus_mut()
         }
 
         /// Reads `WHO_AM_I`; [`Error::WrongDevice`] if it is not an MPU6050.
         pub async fn probe(&mut self) -> Result<(), Error<I::Error>> {
-            match self.read_reg(reg::WHO_AM_I).await? {
-                WHO_AM_I_VALUE => Ok(()),
-                other => Err(Error::WrongDevice(other)),
-            }
+            Ok(self.bus.identify(IDENTITY).await?)
         }
 
         /// Reads `INT_STATUS`, which clears it and releases a latched INT pin.
         pub async fn read_interrupt_status(&mut self) -> Result<InterruptStatus, Error<I::Error>> {
-            Ok(InterruptStatus(self.read_reg(reg::INT_STATUS).await?))
+            Ok(InterruptStatus(self.bus.read_reg(reg::INT_STATUS).await?))
         }
 
         /// From any mode: probes, resets, wakes with the gyro PLL clock and applies `config`
@@ -92,8 +98,7 @@ pub mod driver {
 
         fn into_mode<N: Mode>(self) -> Mpu6050<I, N> {
             Mpu6050 {
-                i2c: self.i2c,
-                address: self.address,
+                bus: self.bus,
                 mode: PhantomData,
             }
         }
@@ -103,34 +108,7 @@ pub mod driver {
             steps: &[Step],
             delay: &mut D,
         ) -> Result<(), Error<I::Error>> {
-            for step in steps {
-                match *step {
-                    Step::Identify => self.probe().await?,
-                    Step::Write { reg, value } => self.write_reg(reg, value).await?,
-                    Step::Check { reg, value } => {
-                        let read = self.read_reg(reg).await?;
-                        if read != value {
-                            return Err(Error::Verify(reg, value, read));
-                        }
-                    }
-                    Step::Read { reg } => {
-                        self.read_reg(reg).await?;
-                    }
-                    Step::WaitMs(ms) => delay.delay_ms(ms).await,
-                }
-            }
-            Ok(())
-        }
-
-        async fn read_reg(&mut self, r: u8) -> Result<u8, Error<I::Error>> {
-            let mut buf = [0u8];
-            self.i2c.write_read(self.address, &[r], &mut buf).await?;
-            Ok(buf[0])
-        }
-
-        async fn write_reg(&mut self, r: u8, value: u8) -> Result<(), Error<I::Error>> {
-            self.i2c.write(self.address, &[r, value]).await?;
-            Ok(())
+            Ok(self.bus.run(steps, delay, IDENTITY).await?)
         }
     }
 
@@ -138,9 +116,7 @@ pub mod driver {
         /// One burst read of the 14 data registers.
         pub async fn read_sample(&mut self) -> Result<RawSample, Error<I::Error>> {
             let mut buf = [0u8; SAMPLE_BYTES];
-            self.i2c
-                .write_read(self.address, &[reg::ACCEL_XOUT_H], &mut buf)
-                .await?;
+            self.bus.read(reg::ACCEL_XOUT_H, &mut buf).await?;
             Ok(crate::sample::from_be_bytes(&buf))
         }
 
@@ -164,9 +140,7 @@ pub mod driver {
         /// Bytes waiting in the FIFO.
         pub async fn fifo_count(&mut self) -> Result<u16, Error<I::Error>> {
             let mut buf = [0u8; 2];
-            self.i2c
-                .write_read(self.address, &[reg::FIFO_COUNT_H], &mut buf)
-                .await?;
+            self.bus.read(reg::FIFO_COUNT_H, &mut buf).await?;
             Ok(u16::from_be_bytes(buf))
         }
 
@@ -195,9 +169,7 @@ pub mod driver {
             };
             for slot in out.iter_mut().take(n) {
                 let mut buf = [0u8; SAMPLE_BYTES];
-                self.i2c
-                    .write_read(self.address, &[reg::FIFO_R_W], &mut buf)
-                    .await?;
+                self.bus.read(reg::FIFO_R_W, &mut buf).await?;
                 *slot = crate::sample::from_be_bytes(&buf);
             }
             Ok(n)
@@ -239,15 +211,4 @@ pub mod driver {
             }
         }
     }
-}
-
-/// The delay of the programs that have no wait step (only [`crate::program::init`] has one).
-pub(crate) struct NoWait;
-
-impl embedded_hal::delay::DelayNs for NoWait {
-    fn delay_ns(&mut self, _ns: u32) {}
-}
-
-impl embedded_hal_async::delay::DelayNs for NoWait {
-    async fn delay_ns(&mut self, _ns: u32) {}
 }

@@ -57,7 +57,6 @@
 
 mod bus;
 mod error;
-pub mod mode;
 pub mod program;
 mod range;
 pub mod register;
@@ -67,6 +66,8 @@ mod settings;
 pub use bus::{asynch, blocking};
 pub use error::{Error, ModeChangeError};
 pub use gaitclip_imu::{AccelScale, GyroScale, RawSample};
+/// The driver's modes, as types (shared by gaitclip's drivers).
+pub use gaitclip_regbus::mode;
 pub use range::{AccelRange, GyroRange};
 pub use register::{FIFO_CAPACITY_BYTES, RESET_DELAY_MS, WHO_AM_I_VALUE};
 pub use sample::SAMPLE_BYTES;

@@ -7,34 +7,7 @@ use crate::sample::SAMPLE_BYTES;
 use crate::settings::{Config, MotionWakeConfig};
 use crate::AccelRange;
 
-/// One step of a register program.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum Step {
-    /// Read `WHO_AM_I`: anything but [`crate::WHO_AM_I_VALUE`] is
-    /// [`crate::Error::WrongDevice`] and ends the program.
-    Identify,
-    /// Write `value` to `reg`.
-    Write {
-        /// Register.
-        reg: u8,
-        /// Value.
-        value: u8,
-    },
-    /// Read `reg` back: anything but `value` is [`crate::Error::Verify`] and ends the program.
-    Check {
-        /// Register.
-        reg: u8,
-        /// The value it must hold.
-        value: u8,
-    },
-    /// Read `reg` and drop the value (reading `INT_STATUS` clears its latch).
-    Read {
-        /// Register.
-        reg: u8,
-    },
-    /// Wait this long, ms (the delay the caller passed).
-    WaitMs(u32),
-}
+pub use gaitclip_regbus::Step;
 
 const fn w(reg: u8, value: u8) -> Step {
     Step::Write { reg, value }

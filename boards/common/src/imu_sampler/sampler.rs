@@ -13,7 +13,7 @@
     sync(self = "blocking"),
     async(self = "asynch")
 )]
-/// The sampler: [`ImuSampler`] over the MPU6050's driver.
+/// The sampler over the MPU6050's driver: `ImuSampler`.
 pub mod driver {
     use embedded_hal_async::delay::DelayNs;
     use embedded_hal_async::i2c::I2c;
