@@ -100,7 +100,7 @@ pub trait SampleTimer: Sized {
 
 /// An external interrupt number of the board, for the NVIC.
 #[derive(Clone, Copy)]
-struct Irq(u16);
+pub(crate) struct Irq(pub(crate) u16);
 
 // Note(unsafe): `Irq` is made only of a timer's `SampleTimer::IRQ`, a valid external
 // interrupt of its device (both QEMU boards have 32).
@@ -174,19 +174,23 @@ pub fn run<D: StepDetector, T: SampleTimer>(
         }
         if TRACE_DONE.load(Ordering::Acquire) && !consumer.ready() {
             timer.stop();
-            finish(pipeline, &mut log, samples);
+            finish(pipeline, &mut log, samples, &LINK.counters(), || {});
         }
-        // Sleep until the next interrupt. Interrupts are masked while checking the queue so
-        // a sample that arrives between the check and `wfi` still wakes the core (WFI wakes
-        // on a pending interrupt even with PRIMASK set).
-        irq::disable();
-        if !consumer.ready() && !TRACE_DONE.load(Ordering::Acquire) {
-            cortex_m::asm::wfi();
-        }
-        // Note(unsafe): re-enables the interrupts disabled just above; no critical section
-        // spans this point.
-        unsafe { irq::enable() };
+        wait_for_interrupt(|| consumer.ready(), &TRACE_DONE);
     }
+}
+
+/// Sleeps until the next interrupt unless an item is `ready` or the trace is `done`.
+/// Interrupts are masked while checking, so an item that arrives between the check and `wfi`
+/// still wakes the core (WFI wakes on a pending interrupt even with PRIMASK set).
+pub(crate) fn wait_for_interrupt(ready: impl Fn() -> bool, done: &AtomicBool) {
+    irq::disable();
+    if !ready() && !done.load(Ordering::Acquire) {
+        cortex_m::asm::wfi();
+    }
+    // Note(unsafe): re-enables the interrupts disabled just above; no critical section
+    // spans this point.
+    unsafe { irq::enable() };
 }
 
 /// One queue item through the pipeline. Not inlined: its temporaries (strides, features)
@@ -228,16 +232,24 @@ fn handle<D: StepDetector>(
     }
 }
 
-/// The end of the trace: the strides still held, the summary, and QEMU's exit.
+/// The end of the trace: the strides still held, what `before_summary` prints, the summary
+/// with the sampler's `counters`, the stack's high-water mark, and QEMU's exit.
 #[inline(never)]
-fn finish<D: StepDetector>(pipeline: &mut Pipeline<D>, log: &mut StrideLog, samples: u32) -> ! {
+pub(crate) fn finish<D: StepDetector>(
+    pipeline: &mut Pipeline<D>,
+    log: &mut StrideLog,
+    samples: u32,
+    counters: &crate::imu_sampler::Counters,
+    before_summary: impl FnOnce(),
+) -> ! {
     let serial = &mut NoSerial;
     while let Some(stride) = pipeline.finish() {
         log.stride(&stride, serial);
     }
+    before_summary();
     log.summary(
         samples,
-        &LINK.counters(),
+        counters,
         &pipeline.clipped_samples(),
         (&pipeline.rejected(), &pipeline.between()),
         serial,

@@ -28,7 +28,7 @@ use heapless::spsc::{Producer, Queue};
 
 use crate::imu_sampler::{Counters, Item};
 use crate::live_app::SpinDelay;
-use crate::replay_app::{fail, SampleTimer};
+use crate::replay_app::{self, fail, wait_for_interrupt, Irq, SampleTimer};
 use crate::replay_lsm6dsv320x::{Recorded, ReplayLsm6dsv320x};
 use crate::startup::Startup;
 use crate::stride_log::{NoSerial, StrideLog};
@@ -130,18 +130,6 @@ impl Sampler {
 static SAMPLER: Mutex<RefCell<Option<Sampler>>> = Mutex::new(RefCell::new(None));
 static TRACE_DONE: AtomicBool = AtomicBool::new(false);
 
-/// An external interrupt number of the board, for the NVIC.
-#[derive(Clone, Copy)]
-struct Irq(u16);
-
-// Note(unsafe): `Irq` is made only of a timer's `SampleTimer::IRQ`, a valid external
-// interrupt of its device (both QEMU boards have 32).
-unsafe impl cortex_m::interrupt::InterruptNumber for Irq {
-    fn number(self) -> u16 {
-        self.0
-    }
-}
-
 /// Runs the stored sprint through `pipeline` (made from [`CONFIG`]) with the timer `T`
 /// ticking at the trace's low-g rate, and exits QEMU.
 pub fn run<D: StepDetector, T: SampleTimer>(
@@ -208,15 +196,7 @@ pub fn run<D: StepDetector, T: SampleTimer>(
             timer.stop();
             finish(pipeline, &mut log, samples);
         }
-        // As replay_app: interrupts masked around the check so a sample queued between the
-        // check and `wfi` still wakes the core.
-        irq::disable();
-        if !consumer.ready() && !TRACE_DONE.load(Ordering::Acquire) {
-            cortex_m::asm::wfi();
-        }
-        // Note(unsafe): re-enables the interrupts disabled just above; no critical section
-        // spans this point.
-        unsafe { irq::enable() };
+        wait_for_interrupt(|| consumer.ready(), &TRACE_DONE);
     }
 }
 
@@ -245,14 +225,10 @@ fn handle<D: StepDetector>(
     }
 }
 
-/// The end of the trace: the strides still held, the merge's counts, the summary, and
-/// QEMU's exit.
+/// The end of the trace: [`crate::replay_app`]'s, with the merge's counts before the
+/// summary.
 #[inline(never)]
 fn finish<D: StepDetector>(pipeline: &mut Pipeline<D>, log: &mut StrideLog, samples: u32) -> ! {
-    let serial = &mut NoSerial;
-    while let Some(stride) = pipeline.finish() {
-        log.stride(&stride, serial);
-    }
     let (counters, merge) = irq::free(|cs| {
         SAMPLER
             .borrow(cs)
@@ -271,24 +247,15 @@ fn finish<D: StepDetector>(pipeline: &mut Pipeline<D>, log: &mut StrideLog, samp
                 )
             })
     });
-    defmt::println!(
-        "merge high_g_axes={=u32} high_g_missing={=u32} unpaired={=u32} high_g_dropped={=u32}",
-        merge.0,
-        merge.1,
-        merge.2,
-        merge.3
-    );
-    log.summary(
-        samples,
-        &counters,
-        &pipeline.clipped_samples(),
-        (&pipeline.rejected(), &pipeline.between()),
-        serial,
-    );
-    let (used, size) = crate::stack_paint::used_and_size();
-    defmt::println!("stack used={=u32} of {=u32} bytes", used, size);
-    cortex_m_semihosting::debug::exit(cortex_m_semihosting::debug::EXIT_SUCCESS);
-    cortex_m::asm::udf()
+    replay_app::finish(pipeline, log, samples, &counters, || {
+        defmt::println!(
+            "merge high_g_axes={=u32} high_g_missing={=u32} unpaired={=u32} high_g_dropped={=u32}",
+            merge.0,
+            merge.1,
+            merge.2,
+            merge.3
+        );
+    })
 }
 
 /// The body of the board's `DefaultHandler`: for the timer's interrupt, one low-g period of
