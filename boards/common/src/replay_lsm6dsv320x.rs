@@ -112,6 +112,11 @@ impl ReplayLsm6dsv320x {
         self.words() / self.recorded.words_per_period.max(1)
     }
 
+    /// Periods ticked so far: the part's own clock, which a board keeps with its timer.
+    pub fn ticked(&self) -> usize {
+        self.periods
+    }
+
     /// Periods not yet ticked.
     pub fn remaining(&self) -> usize {
         self.periods().saturating_sub(self.periods)

@@ -92,19 +92,32 @@ struct Sampler {
     producer: Producer<'static, Item>,
     counters: Counters,
     words: [FifoWord; BURST_WORDS],
+    /// Sample periods accounted for: queued as samples, or as gaps (declared or pending).
+    periods_out: u32,
+    /// Sample periods lost and not yet declared (the queue had no room for the gap).
+    pending_gap: u32,
 }
 
 impl Sampler {
-    /// Reads every waiting word and queues the samples they complete.
+    /// Reads every waiting word and queues the samples they complete. After an overrun the
+    /// FIFO is empty and everything the part's clock counted but the board did not receive
+    /// is declared as one gap: nothing is dropped silently.
     fn drain(&mut self) {
         loop {
             let n = match self.imu.read_fifo(&mut self.words) {
                 Ok(n) => n,
                 Err(lsm::Error::FifoOverflow) => {
                     self.counters.fifo_overflows = self.counters.fifo_overflows.wrapping_add(1);
+                    if let Some(s) = self.assembler.flush() {
+                        self.queue(s);
+                    }
+                    let ticked = self.imu.bus_mut().ticked() as u32;
+                    self.lose(ticked.saturating_sub(self.periods_out));
+                    self.declare_gap();
                     return;
                 }
                 Err(_) => {
+                    // The words stay in the FIFO; the next watermark reads them.
                     self.counters.bus_errors = self.counters.bus_errors.wrapping_add(1);
                     return;
                 }
@@ -120,9 +133,29 @@ impl Sampler {
         }
     }
 
+    /// `n` sample periods lost, to declare as a gap before the next sample.
+    fn lose(&mut self, n: u32) {
+        self.pending_gap = self.pending_gap.saturating_add(n);
+        self.periods_out = self.periods_out.saturating_add(n);
+    }
+
+    /// Declares the pending gap, if the queue has room.
+    fn declare_gap(&mut self) {
+        if self.pending_gap > 0 && self.producer.enqueue(Item::Gap(self.pending_gap)).is_ok() {
+            self.counters.lost_samples =
+                self.counters.lost_samples.saturating_add(self.pending_gap);
+            self.pending_gap = 0;
+        }
+    }
+
+    /// Queues a sample after any pending gap; without room it becomes part of the gap.
     fn queue(&mut self, s: gaitclip::sensor::sample::RawSample) {
-        if self.producer.enqueue(Item::Sample(s)).is_err() {
+        self.declare_gap();
+        if self.pending_gap == 0 && self.producer.enqueue(Item::Sample(s)).is_ok() {
+            self.periods_out = self.periods_out.saturating_add(1);
+        } else {
             self.counters.overruns = self.counters.overruns.wrapping_add(1);
+            self.lose(1);
         }
     }
 }
@@ -179,6 +212,8 @@ pub fn run<D: StepDetector, T: SampleTimer>(
                 slot: 0,
                 data: [0; 3],
             }; BURST_WORDS],
+            periods_out: 0,
+            pending_gap: 0,
         });
     });
     timer.start_periodic(lsm_trace::RATE_HZ * 1000);
@@ -280,6 +315,7 @@ pub fn on_interrupt<T: SampleTimer>(irqn: i16) {
             if let Some(last) = s.assembler.flush() {
                 s.queue(last);
             }
+            s.declare_gap();
             return true;
         }
         part.tick();
