@@ -190,24 +190,22 @@ pub fn record(sc: &Scenario, rec: Recording) -> Recorded {
         }
         Recording::Merged => {
             let dual = rec.dual();
-            let fifo = lsm_fifo(sc);
             let mut asm = Assembler::new(dual);
-            for (w, raw) in fifo.words.iter().zip(&fifo.low_g_counts) {
-                if w.tag == Tag::Accel {
-                    out.accel_railed +=
-                        raw.iter().any(|&v| (v as i32).abs() >= dual.rail_counts()) as usize;
-                }
-            }
-            for w in &fifo.words {
+            let railed = |v: [i16; 3]| v.iter().any(|&c| (c as i32).abs() >= dual.rail_counts());
+            for w in lsm_fifo(sc) {
                 // Each word round-trips through its 7 bytes, as the FIFO delivers it.
                 let w = FifoWord::from_bytes(&w.to_bytes());
-                if w.tag == Tag::Gyro {
-                    let s = RawSample {
-                        accel: [0; 3],
-                        gyro: w.data,
-                        temp: 0,
-                    };
-                    out.gyro_railed += low_rails.gyro_clipped(&s) as usize;
+                match w.tag {
+                    Tag::Accel => out.accel_railed += railed(w.data) as usize,
+                    Tag::Gyro => {
+                        let s = RawSample {
+                            accel: [0; 3],
+                            gyro: w.data,
+                            temp: 0,
+                        };
+                        out.gyro_railed += low_rails.gyro_clipped(&s) as usize;
+                    }
+                    _ => {}
                 }
                 out.samples.extend(asm.push(w));
             }

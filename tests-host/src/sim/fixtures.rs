@@ -80,8 +80,8 @@ pub fn write_all(dir: &Path) -> anyhow::Result<()> {
 /// order) and `<dir>/<name>_lsm6dsv320x.rs`, the module the firmware includes to replay them:
 /// its rate, ranges, words per sample and `FIFO`.
 fn write_lsm_trace_module(dir: &Path, sc: &Scenario) -> anyhow::Result<()> {
-    let fifo = sprint::lsm_fifo(sc);
-    let bytes: Vec<u8> = fifo.words.iter().flat_map(|w| w.to_bytes()).collect();
+    let words = sprint::lsm_fifo(sc);
+    let bytes: Vec<u8> = words.iter().flat_map(|w| w.to_bytes()).collect();
     let data = format!("{}.lsm6dsv320x", sc.name);
     fs::write(dir.join(&data), bytes)?;
     let mut rs = fs::File::create(dir.join(format!("{}_lsm6dsv320x.rs", sc.name)))?;
@@ -114,7 +114,7 @@ fn write_lsm_trace_module(dir: &Path, sc: &Scenario) -> anyhow::Result<()> {
         fs_xl = sprint::LSM_ACCEL.field(),
         fs_hg = sprint::LSM_HIGH_G.field(),
         fs_g = sprint::LSM_GYRO.field(),
-        n = fifo.words.len(),
+        n = words.len(),
     )?;
     Ok(())
 }

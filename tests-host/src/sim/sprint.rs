@@ -80,22 +80,12 @@ pub const LSM_HIGH_G: HighGRange = HighGRange::G128;
 /// The gyroscope's range.
 pub const LSM_GYRO: GyroRange = GyroRange::Dps4000;
 
-/// A sprint as the LSM6DSV320X's FIFO delivers it.
-#[derive(Clone, Debug)]
-pub struct LsmFifo {
-    /// The words in FIFO order: per low-g period, its four high-g words (oldest first), the
-    /// low-g word and the gyroscope word, all with the period's time slot.
-    pub words: Vec<FifoWord>,
-    /// Each word's low-g counts as the part read them (the low-g words' data; zeros for the
-    /// others), for counting the low-g rail.
-    pub low_g_counts: Vec<[i16; 3]>,
-}
-
 /// Records `sc` as the LSM6DSV320X's FIFO would hold it at [`LSM_RATE_HZ`] with the high-g
 /// channel at [`LSM_HIGH_G_RATE_HZ`]: the trajectory sampled at each channel's instants with
 /// the scenario's biases and noise (seeded by the scenario), quantised and saturated at the
-/// channel's scale.
-pub fn lsm_fifo(sc: &Scenario) -> LsmFifo {
+/// channel's scale. The words in FIFO order: per low-g period, its four high-g words (oldest
+/// first), the low-g word and the gyroscope word, all with the period's time slot.
+pub fn lsm_fifo(sc: &Scenario) -> Vec<FifoWord> {
     let mut rng = ChaCha8Rng::seed_from_u64(sc.seed);
     let tr = Trajectory::new(sc, &mut rng);
     let rate = LSM_RATE_HZ as f64;
@@ -105,37 +95,30 @@ pub fn lsm_fifo(sc: &Scenario) -> LsmFifo {
     let (low_k, high_k) = (k(LSM_ACCEL.lsb_per_g()), k(LSM_HIGH_G.lsb_per_g()));
     let gyro_k = LSM_GYRO.scale().lsb_per_dps() * 180.0 / std::f64::consts::PI;
     let counts = |v: [f64; 3], k: f64| v.map(|x| quantize(x * k));
-    let mut out = LsmFifo {
-        words: Vec::with_capacity(n * LSM_WORDS_PER_SAMPLE),
-        low_g_counts: Vec::with_capacity(n * LSM_WORDS_PER_SAMPLE),
-    };
+    let mut out = Vec::with_capacity(n * LSM_WORDS_PER_SAMPLE);
     for i in 0..n {
         let t = i as f64 / rate;
         let slot = (i % 4) as u8;
         // The high-g samples of the period (t − 1/rate, t], oldest first.
         for j in (0..per).rev() {
             let h = tr.sample(t - j as f64 / (rate * per as f64), &mut rng);
-            out.words.push(FifoWord {
+            out.push(FifoWord {
                 tag: Tag::HighG,
                 slot,
                 data: counts(h.acc_mps2, high_k),
             });
-            out.low_g_counts.push([0; 3]);
         }
         let low = tr.sample(t, &mut rng);
-        let a = counts(low.acc_mps2, low_k);
-        out.words.push(FifoWord {
+        out.push(FifoWord {
             tag: Tag::Accel,
             slot,
-            data: a,
+            data: counts(low.acc_mps2, low_k),
         });
-        out.low_g_counts.push(a);
-        out.words.push(FifoWord {
+        out.push(FifoWord {
             tag: Tag::Gyro,
             slot,
             data: counts(low.gyr_radps, gyro_k),
         });
-        out.low_g_counts.push([0; 3]);
     }
     out
 }
