@@ -11,10 +11,14 @@
 //!
 //! Where a reading clips is the core's business (`gaitclip::sensor::sample::Rails`): real
 //! parts clip below their nominal range, so it is learnt or given, never assumed here. The
-//! rate is the core's `SampleRate`, in mHz. What a board's sampler needs of a part (reading
-//! bursts, waking on motion) stays in the board glue, generic over the driver crates.
+//! rate is the core's `SampleRate`, in mHz.
 //!
-//! `no_std`, no heap, no `unsafe`, no dependencies.
+//! What a board's sampler needs of a part (start it, read a sample or a FIFO burst, wait for
+//! motion and come back) is the trait [`source::blocking::ImuSource`] and its async twin,
+//! behind the feature `source`, which every driver crate implements and the core never
+//! enables.
+//!
+//! `no_std`, no heap, no `unsafe`; no dependencies without `source`.
 
 #![no_std]
 #![forbid(unsafe_code)]
@@ -22,6 +26,8 @@
 
 mod sample;
 mod scale;
+#[cfg(feature = "source")]
+pub mod source;
 
 pub use sample::RawSample;
 pub use scale::{AccelScale, GyroScale, Scales};

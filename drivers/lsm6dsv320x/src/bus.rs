@@ -125,20 +125,44 @@ pub mod driver {
 
         /// Reads the words waiting, up to `out.len()`, oldest first; how many. An overrun
         /// empties the FIFO and is [`Error::FifoOverflow`] (the words in it are lost with the
-        /// overwritten ones: a gap).
+        /// overwritten ones: a gap). Each word is its own transfer: a bus error after some
+        /// words were read loses those here; [`Lsm6dsv320x::read_fifo_partial`] keeps them.
         pub async fn read_fifo(&mut self, out: &mut [FifoWord]) -> Result<usize, Error<I::Error>> {
-            let status = self.read_fifo_status().await?;
+            let (n, result) = self.read_fifo_partial(out).await;
+            result.map(|()| n)
+        }
+
+        /// [`Lsm6dsv320x::read_fifo`] that keeps what it read before an error: the words read
+        /// (in `out[..n]`, already gone from the FIFO) and how the read ended.
+        pub async fn read_fifo_partial(
+            &mut self,
+            out: &mut [FifoWord],
+        ) -> (usize, Result<(), Error<I::Error>>) {
+            let status = match self.read_fifo_status().await {
+                Ok(s) => s,
+                Err(e) => return (0, Err(e)),
+            };
             if status.overrun {
-                self.bus
+                let reset = self
+                    .bus
                     .run(&program::RESET_FIFO, &mut gaitclip_regbus::NoWait, IDENTITY)
-                    .await?;
-                return Err(Error::FifoOverflow);
+                    .await;
+                return (
+                    0,
+                    Err(match reset {
+                        Ok(()) => Error::FifoOverflow,
+                        Err(e) => e.into(),
+                    }),
+                );
             }
             let n = out.len().min(status.words as usize);
-            for slot in out.iter_mut().take(n) {
-                *slot = self.read_fifo_word().await?;
+            for (k, slot) in out.iter_mut().take(n).enumerate() {
+                match self.read_fifo_word().await {
+                    Ok(w) => *slot = w,
+                    Err(e) => return (k, Err(e)),
+                }
             }
-            Ok(n)
+            (n, Ok(()))
         }
 
         /// Into the wait for motion ([`program::enter_motion_wake`]). On failure the driver

@@ -13,6 +13,9 @@ pub enum Error<E> {
     /// A register read back other than what it must hold (register, expected, read): after
     /// the software reset, `CTRL3` still resetting.
     Verify(u8, u8, u8),
+    /// Asked of the part in a mode that cannot do it: a FIFO read while it waits for motion,
+    /// or a read mode the handle does not offer (it delivers through the FIFO's watermark).
+    Mode,
 }
 
 impl<E> From<E> for Error<E> {

@@ -14,7 +14,9 @@
 //! - [`merge`]: the two accelerometers merged into one unclipped specific force, in fixed
 //!   point ([`merge::DualRange`]), and the FIFO's words assembled into the pipeline's
 //!   [`gaitclip_imu::RawSample`]s at the low-g rate ([`merge::Assembler`]);
-//! - the bus driver, [`blocking::Lsm6dsv320x`] and [`asynch::Lsm6dsv320x`].
+//! - the bus driver, [`blocking::Lsm6dsv320x`] and [`asynch::Lsm6dsv320x`];
+//! - [`source`]: the handle a board's sampler drives ([`blocking::Lsm6dsv320xSource`]), the
+//!   seam's [`gaitclip_imu::source`] traits on top of the driver and the merge.
 //!
 //! ## The bus driver
 //!
@@ -58,8 +60,18 @@ pub mod program;
 pub mod range;
 pub mod register;
 mod settings;
+pub mod source;
 
-pub use bus::{asynch, blocking};
+/// The driver and the sampler's handle, blocking (on [`embedded_hal`]).
+pub mod blocking {
+    pub use crate::bus::blocking::*;
+    pub use crate::source::blocking::*;
+}
+/// The driver and the sampler's handle, async (on [`embedded_hal_async`]).
+pub mod asynch {
+    pub use crate::bus::asynch::*;
+    pub use crate::source::asynch::*;
+}
 pub use error::{Error, ModeChangeError};
 /// The driver's modes, as types (shared by gaitclip's drivers).
 pub use gaitclip_regbus::mode;

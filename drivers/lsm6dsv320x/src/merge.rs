@@ -182,6 +182,20 @@ impl Assembler {
         done
     }
 
+    /// The same assembler with the period it was assembling dropped (its FIFO was emptied:
+    /// the caller's gap covers that period); the counts so far stay.
+    pub const fn restarted(self) -> Self {
+        Assembler {
+            slot: None,
+            accel: None,
+            gyro: None,
+            temp: 0,
+            high_sum: [0; 3],
+            high_n: 0,
+            ..self
+        }
+    }
+
     /// Completes the last slot's sample, if it has one.
     pub fn flush(&mut self) -> Option<RawSample> {
         self.slot = None;

@@ -1,5 +1,6 @@
 //! What the caller configures: the bus address, output rates, the FIFO, the motion wake-up.
 
+use crate::merge::DualRange;
 use crate::range::{AccelRange, GyroRange, HighGRange};
 
 /// The part's I²C address, set by its SA0 pin.
@@ -175,6 +176,36 @@ impl Config {
             }),
             watermark_words: 48,
         }
+    }
+    /// FIFO words per low-g period: the accelerometer's, the gyroscope's, and the high-g
+    /// channel's samples of the period (its rate over the low-g one, rounded down).
+    pub const fn words_per_period(&self) -> u32 {
+        2 + match self.high_g {
+            Some(h) => h.odr.hz() * 1000 / self.odr.millihertz(),
+            None => 0,
+        }
+    }
+
+    /// Low-g periods the FIFO holds when INT1 rises (at least 1).
+    pub const fn watermark_periods(&self) -> u32 {
+        let p = self.watermark_words as u32 / self.words_per_period();
+        if p == 0 {
+            1
+        } else {
+            p
+        }
+    }
+
+    /// The two accelerometers as the FIFO's samples merge them: the high-g channel's range,
+    /// or, with it off, ±32 g (the low-g counts rescaled, nothing to merge).
+    pub const fn dual_range(&self) -> DualRange {
+        DualRange::new(
+            self.accel,
+            match self.high_g {
+                Some(h) => h.range,
+                None => HighGRange::G32,
+            },
+        )
     }
 }
 

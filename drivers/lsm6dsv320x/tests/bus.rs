@@ -288,6 +288,25 @@ mod cases {
         bus.done();
     }
 
+    pub async fn a_word_that_fails_keeps_the_words_read_before_it() {
+        let (mut bus, mut imu) = sampling(vec![
+            T::write_read(ADDR, vec![FIFO_STATUS1], vec![0x03, 0x00]),
+            word(0x02, 2, [1, 2, 3]),
+            word(0x01, 2, [4, 5, 6]),
+            T::write_read(ADDR, vec![FIFO_DATA_OUT_TAG], vec![0; 7]).with_error(ErrorKind::Other),
+        ])
+        .await;
+        let mut out = [FifoWord {
+            tag: Tag::Other(0),
+            slot: 0,
+            data: [0; 3],
+        }; 8];
+        let (n, result) = imu.read_fifo_partial(&mut out).await;
+        assert_eq!((n, result), (2, Err(Error::Bus(ErrorKind::Other))));
+        assert_eq!((out[0].data, out[1].data), ([1, 2, 3], [4, 5, 6]));
+        bus.done();
+    }
+
     pub async fn motion_wake_in_and_out() {
         let mut rest = enter_wake();
         // Not yet, then the wake-up (WU_IA, bit 1, with the axis bits).
@@ -335,5 +354,6 @@ both!(
     fifo_words_in_order_with_their_slots,
     fifo_reads_no_more_than_the_buffer_holds_and_counts_bit_8,
     an_overrun_empties_the_fifo_and_is_an_error,
+    a_word_that_fails_keeps_the_words_read_before_it,
     motion_wake_in_and_out,
 );

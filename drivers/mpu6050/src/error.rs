@@ -14,6 +14,9 @@ pub enum Error<E> {
     FifoMisaligned(u16),
     /// A register read back other than what was written (register, written, read).
     Verify(u8, u8, u8),
+    /// Asked of the part in a mode that cannot do it: a sample read while it waits for
+    /// motion, or a read mode it does not have (the FIFO has no watermark interrupt).
+    Mode,
 }
 
 impl<E> From<E> for Error<E> {

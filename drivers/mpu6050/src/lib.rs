@@ -62,8 +62,18 @@ mod range;
 pub mod register;
 pub mod sample;
 mod settings;
+mod source;
 
-pub use bus::{asynch, blocking};
+/// The driver and the sampler's handle, blocking (on [`embedded_hal`]).
+pub mod blocking {
+    pub use crate::bus::blocking::*;
+    pub use crate::source::blocking::*;
+}
+/// The driver and the sampler's handle, async (on [`embedded_hal_async`]).
+pub mod asynch {
+    pub use crate::bus::asynch::*;
+    pub use crate::source::asynch::*;
+}
 pub use error::{Error, ModeChangeError};
 pub use gaitclip_imu::{AccelScale, GyroScale, RawSample};
 /// The driver's modes, as types (shared by gaitclip's drivers).
