@@ -10,10 +10,15 @@
 //! | VCC / GND | VDD / GND | 3.3 V (or the coin cell) |
 //! | serial out | P0.06 (TXD) | UARTE0, 115 200 8N1: the DK's USB virtual COM port |
 //!
+//! Built with `--features lsm6dsv320x` it samples an LSM6DSV320X on the same pins instead
+//! (SA0 to ground, INT1 as INT): 240 Hz, its FIFO read whenever INT1 says it holds its
+//! watermark, the high-g channel merged into the accelerometer
+//! ([`gaitclip_board::live_settings::lsm6dsv320x`]).
+//!
 //! **Priorities.** Nordic's SoftDevice Controller owns the radio, RTC0 and TIMER0 at
 //! priority 0 and its low-priority work at 4 (nrf-mpsl sets them). The sampler runs in an
 //! interrupt executor at priority 3, woken by GPIOTE at 2: it reads the FIFO every
-//! [`FIFO_BATCH`] data-ready pulses and ticks the sensor watchdog, and is never held up by
+//! [`MODE`]'s batch of data-ready pulses and ticks the sensor watchdog, and is never held up by
 //! the Bluetooth host or the pipeline, which run in thread mode. Critical sections are
 //! nrf-mpsl's: they mask the application's interrupts, never the radio's.
 //!
@@ -45,16 +50,14 @@ use embassy_sync::signal::Signal;
 use embassy_time::{Delay, Duration, Instant, Ticker, Timer};
 use gaitclip::pipeline::Pipeline;
 use gaitclip_board::imu_sampler::asynch::ImuSampler;
-use gaitclip_board::imu_sampler::{BusRecovery, Counters, Item, ReadMode};
+use gaitclip_board::imu_sampler::{BusRecovery, Counters, Item};
 use gaitclip_board::live_app::{self, Drain, Watchdog, WATCHDOG_TICK_MS};
 use gaitclip_board::live_settings::MOVEMENT_SAMPLES;
-use gaitclip_board::live_settings::{CONFIG, FIFO_BATCH, QUEUE_LEN, RATE, SENSOR};
+use gaitclip_board::live_settings::{self, CONFIG, MODE, QUEUE_LEN, RATE, SLEEP};
 use gaitclip_board::rsc_gatt::{self, battery_percent, PodLink};
-use gaitclip_board::sleep::{SleepPolicy, SLEEP};
+use gaitclip_board::sleep::SleepPolicy;
 use gaitclip_board::stride_log::StrideLog;
 use gaitclip_board::{serial_line, stack_paint, Steps};
-use gaitclip_mpu6050::asynch::Mpu6050;
-use gaitclip_mpu6050::Address;
 use heapless::spsc::{Consumer, Producer, Queue};
 use nrf_sdc::mpsl::MultiprotocolServiceLayer;
 use nrf_sdc::{self as sdc, mpsl};
@@ -206,7 +209,7 @@ async fn mpsl_task(mpsl: &'static MultiprotocolServiceLayer<'static>) -> ! {
     mpsl.run().await
 }
 
-/// The sampler: a FIFO burst every [`FIFO_BATCH`] pulses of INT (GPIOTE channel 0's rising
+/// The sampler: a FIFO burst every [`MODE`]'s batch of pulses of INT (GPIOTE channel 0's rising
 /// edge, which catches the 50 µs pulses), and the sensor watchdog. While the sensor waits
 /// for motion ([`gaitclip_board::sleep`]) the channel is released and INT is watched by the
 /// pin's SENSE (the PORT event: no high-frequency clock requested; the latched motion
@@ -214,7 +217,7 @@ async fn mpsl_task(mpsl: &'static MultiprotocolServiceLayer<'static>) -> ! {
 /// embassy's RTC time base.
 #[embassy_executor::task]
 async fn sampler_task(
-    mut sampler: ImuSampler<Bus, Delay>,
+    mut sampler: ImuSampler<live_settings::AsyncSource<Bus>, Delay>,
     mut producer: Producer<'static, Item>,
     mut channel: Peri<'static, peripherals::GPIOTE_CH0>,
     mut int_pin: Peri<'static, peripherals::P0_03>,
@@ -266,7 +269,7 @@ async fn sampler_task(
 }
 
 /// The sampler's counters for the status line, and the pipeline task woken.
-fn publish(sampler: &ImuSampler<Bus, Delay>) {
+fn publish(sampler: &ImuSampler<live_settings::AsyncSource<Bus>, Delay>) {
     let c = sampler.counters();
     COUNTERS.lock(|cell| cell.set(c));
     QUEUED.signal(());
@@ -280,7 +283,7 @@ async fn pipeline_task(
     mut log: StrideLog,
     mut serial: Serial,
 ) -> ! {
-    let mut drain = Drain::new(&CONFIG, QUEUE_LEN);
+    let mut drain = Drain::new(&CONFIG, QUEUE_LEN, &SLEEP);
     let status_every = RATE.samples_in_ms(live_app::STATUS_EVERY_MS);
     let mut next_status = status_every;
     loop {
@@ -436,9 +439,8 @@ async fn main(spawner: Spawner) {
             TX_RAM.take(),
         ),
     };
-    let imu = Mpu6050::new(bus, Address::Ad0Low);
-    let mode = ReadMode::Fifo { batch: FIFO_BATCH };
-    let sampler = live_app::start_async_sensor(imu, Delay, SENSOR, mode, &mut serial).await;
+    let imu = live_settings::async_source(bus);
+    let sampler = live_app::start_async_sensor(imu, Delay, MODE, &mut serial).await;
     let (producer, consumer) = QUEUE.take().split();
 
     interrupt::EGU1_SWI1.set_priority(Priority::P3);

@@ -8,8 +8,13 @@
 //! | VCC / GND | VDD / GND | 3.3 V |
 //! | serial out | P0.06 (TXD) | UARTE0, 115 200 8N1: the DK's USB virtual COM port |
 //!
+//! Built with `--features lsm6dsv320x` it samples an LSM6DSV320X on the same pins instead
+//! (SA0 to ground, INT1 as INT): 240 Hz, its FIFO read whenever INT1 says it holds its
+//! watermark, the high-g channel merged into the accelerometer
+//! ([`gaitclip_board::live_settings::lsm6dsv320x`]).
+//!
 //! The sensor runs at 200 Hz with its FIFO on and pulses INT on every data-ready; the GPIOTE
-//! handler counts pulses and reads the FIFO every [`FIFO_BATCH`] of them in one burst
+//! handler counts pulses and reads the FIFO every [`MODE`]'s batch of them in one burst
 //! ([`imu_sampler`]), pushing samples into the queue. TIMER1 ticks the sensor watchdog. The
 //! main loop runs the pipeline and sleeps (`wfi`). Strides go to defmt over RTT
 //! (`probe-rs run`) and, as CSV lines, to the UART.
@@ -32,8 +37,6 @@ use defmt_rtt as _;
 use embedded_hal::i2c::{ErrorType, I2c, Operation, SevenBitAddress};
 use gaitclip::pipeline::Pipeline;
 use gaitclip_board::live_settings::MOVEMENT_SAMPLES;
-use gaitclip_mpu6050::blocking::Mpu6050;
-use gaitclip_mpu6050::Address;
 use heapless::spsc::Queue;
 use nrf52840_hal::{
     self as hal,
@@ -48,9 +51,9 @@ use nrf52840_hal::{
 use panic_probe as _;
 use static_cell::ConstStaticCell;
 
-use gaitclip_board::live_settings::{CONFIG, FIFO_BATCH, QUEUE_LEN, RATE, SENSOR};
-use gaitclip_board::sleep::{SleepPolicy, SLEEP};
-use imu_sampler::{BusRecovery, Item, ReadMode};
+use gaitclip_board::live_settings::{self, CONFIG, MODE, QUEUE_LEN, RATE, SLEEP};
+use gaitclip_board::sleep::SleepPolicy;
+use imu_sampler::{BusRecovery, Item};
 use live_app::{IntEvent, SampleLink, SpinDelay, Watchdog, WATCHDOG_TICK_MS};
 use stride_log::StrideLog;
 
@@ -102,7 +105,7 @@ impl BusRecovery for RecoverableTwim {
 }
 
 /// Sampler, queue producer and pulse count, shared by the interrupts and the main loop.
-static LINK: SampleLink<RecoverableTwim, SpinDelay> = SampleLink::new();
+static LINK: SampleLink<live_settings::Source<RecoverableTwim>, SpinDelay> = SampleLink::new();
 /// RTC0 at [`SLEEP_CLOCK_HZ`], and its count when the sensor went to sleep.
 type SleepClock = (Rtc<RTC0>, u32);
 static SLEEP_CLOCK: Mutex<RefCell<Option<SleepClock>>> = Mutex::new(RefCell::new(None));
@@ -168,9 +171,8 @@ fn main() -> ! {
     let delay = SpinDelay {
         cycles_per_us: CYCLES_PER_US,
     };
-    let imu = Mpu6050::new(bus, Address::Ad0Low);
-    let mode = ReadMode::Fifo { batch: FIFO_BATCH };
-    let consumer = LINK.start(imu, delay, SENSOR, mode, QUEUE.take(), &mut serial);
+    let imu = live_settings::source(bus);
+    let consumer = LINK.start(imu, delay, MODE, QUEUE.take(), &mut serial);
     let int_pin = port0.p0_03.into_floating_input().degrade();
     let gpiote = Gpiote::new(p.GPIOTE);
     gpiote
@@ -193,7 +195,14 @@ fn main() -> ! {
         pac::NVIC::unmask(pac::Interrupt::TIMER1);
     }
 
-    LINK.main_loop(PIPELINE.take(), &CONFIG, consumer, &mut log, &mut serial)
+    LINK.main_loop(
+        PIPELINE.take(),
+        &CONFIG,
+        consumer,
+        &mut log,
+        &mut serial,
+        &SLEEP,
+    )
 }
 
 #[interrupt]

@@ -8,6 +8,11 @@
 //! | VCC / GND | 3V3(OUT) (pin 36) / GND (pin 38) | |
 //! | serial out | GP0 (pin 1, UART0 TX) | 115 200 8N1, to a USB-serial adapter's RX |
 //!
+//! Built with `--features lsm6dsv320x` it samples an LSM6DSV320X on the same pins instead
+//! (SA0 to ground, INT1 as INT): 240 Hz, its FIFO read whenever INT1 says it holds its
+//! watermark, the high-g channel merged into the accelerometer
+//! ([`gaitclip_board::live_settings::lsm6dsv320x`]).
+//!
 //! Same firmware as the nRF52840 board: FIFO bursts on data-ready pulses, the shared sampler
 //! with retries, bus recovery and re-initialisation, the TIMER alarm as the sensor
 //! watchdog, the pipeline in the main loop with `wfi`, strides on defmt-RTT and the UART.
@@ -31,8 +36,6 @@ use embedded_hal::i2c::{ErrorType, I2c, Operation, SevenBitAddress};
 use fugit::{HertzU32, RateExtU32};
 use gaitclip::pipeline::Pipeline;
 use gaitclip_board::live_settings::MOVEMENT_SAMPLES;
-use gaitclip_mpu6050::blocking::Mpu6050;
-use gaitclip_mpu6050::Address;
 use heapless::spsc::Queue;
 use panic_probe as _;
 use rp2040_hal::{
@@ -50,9 +53,9 @@ use rp2040_hal::{
 };
 use static_cell::ConstStaticCell;
 
-use gaitclip_board::live_settings::{CONFIG, FIFO_BATCH, QUEUE_LEN, RATE, SENSOR};
-use gaitclip_board::sleep::{SleepPolicy, SLEEP};
-use imu_sampler::{BusRecovery, Item, ReadMode};
+use gaitclip_board::live_settings::{self, CONFIG, MODE, QUEUE_LEN, RATE, SLEEP};
+use gaitclip_board::sleep::SleepPolicy;
+use imu_sampler::{BusRecovery, Item};
 use live_app::{IntEvent, SampleLink, SpinDelay, Watchdog as SensorWatchdog, WATCHDOG_TICK_MS};
 use stride_log::StrideLog;
 
@@ -118,7 +121,7 @@ impl BusRecovery for RecoverableI2c {
 }
 
 /// Sampler, queue producer and pulse count, shared by the interrupts and the main loop.
-static LINK: SampleLink<RecoverableI2c, SpinDelay> = SampleLink::new();
+static LINK: SampleLink<live_settings::Source<RecoverableI2c>, SpinDelay> = SampleLink::new();
 static INT_PIN: Mutex<RefCell<Option<IntPin>>> = Mutex::new(RefCell::new(None));
 static WATCHDOG: Mutex<RefCell<Option<(Alarm0, SensorWatchdog)>>> = Mutex::new(RefCell::new(None));
 /// The TIMER, and its count (µs) when the sensor went to sleep.
@@ -182,9 +185,8 @@ fn main() -> ! {
     let delay = SpinDelay {
         cycles_per_us: CYCLES_PER_US,
     };
-    let imu = Mpu6050::new(bus, Address::Ad0Low);
-    let mode = ReadMode::Fifo { batch: FIFO_BATCH };
-    let consumer = LINK.start(imu, delay, SENSOR, mode, QUEUE.take(), &mut serial);
+    let imu = live_settings::source(bus);
+    let consumer = LINK.start(imu, delay, MODE, QUEUE.take(), &mut serial);
     let int_pin: IntPin = pins.gpio6.into_pull_down_input();
     int_pin.set_interrupt_enabled(PinInterrupt::EdgeHigh, true);
     let Some(mut alarm) = timer.alarm_0() else {
@@ -206,7 +208,14 @@ fn main() -> ! {
         pac::NVIC::unmask(pac::Interrupt::TIMER_IRQ_0);
     }
 
-    LINK.main_loop(PIPELINE.take(), &CONFIG, consumer, &mut log, &mut serial)
+    LINK.main_loop(
+        PIPELINE.take(),
+        &CONFIG,
+        consumer,
+        &mut log,
+        &mut serial,
+        &SLEEP,
+    )
 }
 
 #[interrupt]

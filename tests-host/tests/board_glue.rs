@@ -7,7 +7,7 @@ use gaitclip::pipeline::Pipeline;
 use gaitclip::sensor::rate::SampleRate;
 use gaitclip::sensor::sample::RawSample;
 use gaitclip_board::{imu_sampler, replay_mpu6050, serial_line, startup};
-use gaitclip_mpu6050::blocking::Mpu6050;
+use gaitclip_mpu6050::blocking::{Mpu6050, Mpu6050Source};
 use gaitclip_mpu6050::{AccelRange, GyroRange};
 use gaitclip_mpu6050::{Address, Config, OutputRate};
 use imu_sampler::{BusRecovery, Counters, ImuSampler, Item, ReadMode};
@@ -60,9 +60,8 @@ fn run(fail: std::ops::Range<usize>, pulses: usize) -> (Vec<Item>, Counters) {
     };
     let config = Config::new(OutputRate::from_hz(200).unwrap());
     let Ok(mut s) = ImuSampler::start(
-        Mpu6050::new(bus, Address::Ad0Low),
+        Mpu6050Source::new(Mpu6050::new(bus, Address::Ad0Low), config),
         NoopDelay,
-        config,
         ReadMode::PerSample,
     ) else {
         panic!("the sensor starts");
@@ -144,9 +143,11 @@ fn a_full_queue_becomes_a_gap_not_a_silent_loss() {
         recoveries: 0,
     };
     let Ok(mut s) = ImuSampler::start(
-        Mpu6050::new(bus, Address::Ad0Low),
+        Mpu6050Source::new(
+            Mpu6050::new(bus, Address::Ad0Low),
+            Config::new(OutputRate::from_hz(200).unwrap()),
+        ),
         NoopDelay,
-        Config::new(OutputRate::from_hz(200).unwrap()),
         ReadMode::PerSample,
     ) else {
         panic!("the sensor starts");

@@ -16,7 +16,7 @@ use gaitclip::pipeline::Pipeline;
 use gaitclip::record::stride::{Stride, StrideFlags};
 use gaitclip::sensor::rate::SampleRate;
 use gaitclip_board::imu_sampler::{self, asynch};
-use gaitclip_mpu6050::blocking::Mpu6050;
+use gaitclip_mpu6050::blocking::{Mpu6050, Mpu6050Source};
 use gaitclip_mpu6050::{AccelRange, GyroRange};
 use gaitclip_mpu6050::{Address, Config, OutputRate};
 use imu_sampler::{BusRecovery, Counters, ImuSampler, Item, ReadMode, RESTART_AFTER, RETRIES};
@@ -169,8 +169,8 @@ const FLAVORS: [Flavor; 2] = [Flavor::Blocking, Flavor::Async];
 /// Either sampler behind one face; the async one's futures run to completion at once
 /// (the mock never makes them wait).
 enum Sampler {
-    Blocking(ImuSampler<Bus, NoopDelay>),
-    Async(asynch::ImuSampler<Bus, NoopDelay>),
+    Blocking(ImuSampler<Mpu6050Source<Bus>, NoopDelay>),
+    Async(asynch::ImuSampler<gaitclip_mpu6050::asynch::Mpu6050Source<Bus>, NoopDelay>),
 }
 
 impl Sampler {
@@ -180,15 +180,19 @@ impl Sampler {
         let bus = Bus { mock: mock.clone() };
         let config = Config::new(OutputRate::from_hz(200).unwrap());
         let sampler = match flavor {
-            Flavor::Blocking => {
-                ImuSampler::start(Mpu6050::new(bus, Address::Ad0Low), NoopDelay, config, mode)
-                    .map(Sampler::Blocking)
-                    .ok()
-            }
-            Flavor::Async => futures_executor::block_on(asynch::ImuSampler::start(
-                gaitclip_mpu6050::asynch::Mpu6050::new(bus, Address::Ad0Low),
+            Flavor::Blocking => ImuSampler::start(
+                Mpu6050Source::new(Mpu6050::new(bus, Address::Ad0Low), config),
                 NoopDelay,
-                config,
+                mode,
+            )
+            .map(Sampler::Blocking)
+            .ok(),
+            Flavor::Async => futures_executor::block_on(asynch::ImuSampler::start(
+                gaitclip_mpu6050::asynch::Mpu6050Source::new(
+                    gaitclip_mpu6050::asynch::Mpu6050::new(bus, Address::Ad0Low),
+                    config,
+                ),
+                NoopDelay,
                 mode,
             ))
             .map(Sampler::Async)

@@ -10,7 +10,7 @@ use gaitclip_board::replay_mpu6050::{
     mg_to_counts, motion_between, periods_per_wake, ReplayMpu6050, WakeTick, REPLAY_MOTION_UNIT,
 };
 use gaitclip_board::sleep::{SleepPolicy, SLEEP, WAKE_THRESHOLD_MG};
-use gaitclip_mpu6050::blocking::Mpu6050;
+use gaitclip_mpu6050::blocking::{Mpu6050, Mpu6050Source};
 use gaitclip_mpu6050::{Address, Config, OutputRate};
 
 const RATE: u32 = 200;
@@ -75,13 +75,12 @@ fn trace_bytes() -> &'static [u8] {
 }
 
 /// The sampler on the emulated sensor serving `trace`, per-sample reads at 200 Hz.
-fn sampler_on(trace: &'static [u8]) -> ImuSampler<ReplayMpu6050, NoopDelay> {
+fn sampler_on(trace: &'static [u8]) -> ImuSampler<Mpu6050Source<ReplayMpu6050>, NoopDelay> {
     let bus = ReplayMpu6050::with_still(0x68, trace, 200_000, &[], &[]);
     let config = Config::new(OutputRate::from_hz(200).unwrap());
     match ImuSampler::start(
-        Mpu6050::new(bus, Address::Ad0Low),
+        Mpu6050Source::new(Mpu6050::new(bus, Address::Ad0Low), config),
         NoopDelay,
-        config,
         ReadMode::PerSample,
     ) {
         Ok(s) => s,
@@ -332,9 +331,8 @@ fn sleep_and_wake_on_the_bus_transaction_by_transaction() {
     // The blocking sampler of the bare-metal boards.
     let mock = Mock::new(&expected);
     let Ok(mut s) = ImuSampler::start(
-        Mpu6050::new(MockBus(mock.clone()), Address::Ad0Low),
+        Mpu6050Source::new(Mpu6050::new(MockBus(mock.clone()), Address::Ad0Low), config),
         NoopDelay,
-        config,
         ReadMode::Fifo { batch: 1 },
     ) else {
         panic!("the sensor starts");
@@ -352,9 +350,11 @@ fn sleep_and_wake_on_the_bus_transaction_by_transaction() {
     // The async sampler of the Bluetooth board: the same transactions and items.
     let mock = Mock::new(&expected);
     let Ok(mut s) = futures_executor::block_on(asynch::ImuSampler::start(
-        gaitclip_mpu6050::asynch::Mpu6050::new(MockBus(mock.clone()), Address::Ad0Low),
+        gaitclip_mpu6050::asynch::Mpu6050Source::new(
+            gaitclip_mpu6050::asynch::Mpu6050::new(MockBus(mock.clone()), Address::Ad0Low),
+            config,
+        ),
         NoopDelay,
-        config,
         ReadMode::Fifo { batch: 1 },
     )) else {
         panic!("the sensor starts (async)");

@@ -13,19 +13,16 @@ use core::sync::atomic::{AtomicU32, Ordering};
 use cortex_m::interrupt::{self as irq, Mutex};
 use embedded_hal::delay::DelayNs;
 use embedded_hal::digital::OutputPin;
-use embedded_hal::i2c::I2c;
 use gaitclip::detect::seam::StepDetector;
 use gaitclip::pipeline::config::Config;
 use gaitclip::pipeline::Pipeline;
 use gaitclip::record::stride::Stride;
-use gaitclip_mpu6050 as mpu6050;
-use gaitclip_mpu6050::blocking::Mpu6050;
-use gaitclip_mpu6050::mode::Unconfigured;
+use gaitclip_imu::source::blocking::ImuSource;
 use heapless::spsc::{Consumer, Producer, Queue};
 
 use crate::imu_sampler::{BusRecovery, Counters, ImuSampler, Item, ReadMode};
 use crate::serial_line;
-use crate::sleep::{SleepPolicy, SLEEP};
+use crate::sleep::{SleepPolicy, SleepSettings, WakeFigures};
 use crate::startup::Startup;
 use crate::stride_log::StrideLog;
 
@@ -39,17 +36,18 @@ pub const SILENT_TICKS: u32 = 3;
 
 /// What the interrupts share with the main loop: the sampler, the queue's producer and the
 /// count of data-ready pulses. A board keeps one in a static.
-pub struct SampleLink<I, D> {
-    sampler: Mutex<RefCell<Option<ImuSampler<I, D>>>>,
+pub struct SampleLink<S: ImuSource, D> {
+    sampler: Mutex<RefCell<Option<ImuSampler<S, D>>>>,
     producer: Mutex<RefCell<Option<Producer<'static, Item>>>>,
     /// Data-ready interrupts so far. Written by the INT handler only, with a load and a
     /// store: ARMv6-M has no atomic read-modify-write.
     pulses: AtomicU32,
 }
 
-impl<I, D> Default for SampleLink<I, D>
+impl<S, D> Default for SampleLink<S, D>
 where
-    I: I2c + BusRecovery,
+    S: ImuSource,
+    S::Bus: BusRecovery,
     D: DelayNs,
 {
     fn default() -> Self {
@@ -57,9 +55,10 @@ where
     }
 }
 
-impl<I, D> SampleLink<I, D>
+impl<S, D> SampleLink<S, D>
 where
-    I: I2c + BusRecovery,
+    S: ImuSource,
+    S::Bus: BusRecovery,
     D: DelayNs,
 {
     /// An empty link, for a static.
@@ -75,21 +74,20 @@ where
     /// the interrupts, and returns the queue's consumer for the main loop.
     pub fn start<const N: usize>(
         &self,
-        imu: Mpu6050<I, Unconfigured>,
+        imu: S,
         delay: D,
-        config: mpu6050::Config,
         mode: ReadMode,
         queue: &'static mut Queue<Item, N>,
         serial: &mut impl Write,
     ) -> Consumer<'static, Item> {
-        let sampler = start_sensor(imu, delay, config, mode, serial);
+        let sampler = start_sensor(imu, delay, mode, serial);
         let (producer, consumer) = queue.split();
         self.install(sampler, producer);
         consumer
     }
 
     /// Hands the started sampler and the queue's producer to the interrupts.
-    pub fn install(&self, sampler: ImuSampler<I, D>, producer: Producer<'static, Item>) {
+    pub fn install(&self, sampler: ImuSampler<S, D>, producer: Producer<'static, Item>) {
         irq::free(|cs| {
             self.sampler.borrow(cs).replace(Some(sampler));
             self.producer.borrow(cs).replace(Some(producer));
@@ -152,16 +150,23 @@ where
     }
 
     /// Processes the queue forever, reporting start-up ([`Startup`]), strides, gaps and a
-    /// status line (with the sampler's fault counters) every [`STATUS_EVERY_MS`].
-    pub fn main_loop<S: StepDetector>(
+    /// status line (with the sampler's fault counters) every [`STATUS_EVERY_MS`]. When the
+    /// foot has been still for `sleep`'s still period, the part waits for motion with its
+    /// `wake` settings.
+    #[allow(clippy::too_many_arguments)]
+    pub fn main_loop<P: StepDetector>(
         &self,
-        pipeline: &mut Pipeline<S>,
+        pipeline: &mut Pipeline<P>,
         config: &Config,
         mut consumer: Consumer<'static, Item>,
         log: &mut StrideLog,
         serial: &mut impl Write,
-    ) -> ! {
-        let mut drain = Drain::new(config, consumer.capacity());
+        sleep: &SleepSettings<S::Wake>,
+    ) -> !
+    where
+        S::Wake: WakeFigures,
+    {
+        let mut drain = Drain::new(config, consumer.capacity(), sleep);
         loop {
             drain.run(
                 pipeline,
@@ -172,7 +177,7 @@ where
                 |_| {},
             );
             if let Some(after) = drain.take_sleep_request() {
-                self.request_sleep(after, SLEEP.wake);
+                self.request_sleep(after, sleep.wake);
             }
             // Interrupts are masked while checking the queue so that a sample arriving between
             // the check and `wfi` still wakes the core (WFI wakes on a pending interrupt even
@@ -191,7 +196,7 @@ where
     /// before [`SampleLink::install`].
     pub fn with_sampler<R>(
         &self,
-        f: impl FnOnce(&mut ImuSampler<I, D>, &mut dyn FnMut(Item) -> bool) -> R,
+        f: impl FnOnce(&mut ImuSampler<S, D>, &mut dyn FnMut(Item) -> bool) -> R,
     ) -> Option<R> {
         irq::free(|cs| {
             let mut sampler = self.sampler.borrow(cs).borrow_mut();
@@ -209,7 +214,7 @@ where
     }
 
     /// Asks the sampler to sleep after `after` samples in all ([`ImuSampler::request_sleep`]).
-    pub fn request_sleep(&self, after: u32, wake: gaitclip_mpu6050::MotionWakeConfig) {
+    pub fn request_sleep(&self, after: u32, wake: S::Wake) {
         self.with_sampler(|s, _| s.request_sleep(after, wake));
     }
 }
@@ -228,8 +233,10 @@ pub enum IntEvent {
 /// The main loop's work on what the sampler queued: the pipeline, start-up reporting, the
 /// stride log, gaps and the periodic status line. A board with a blocking main loop runs it
 /// between `wfi`s ([`SampleLink::main_loop`]); the Bluetooth board from its pipeline task.
-pub struct Drain {
+pub struct Drain<W = gaitclip_mpu6050::MotionWakeConfig> {
     startup: Startup,
+    /// When the clip sleeps, and what the log says of it.
+    sleep: SleepSettings<W>,
     status_every_samples: u32,
     samples: u32,
     next_status: u32,
@@ -240,17 +247,18 @@ pub struct Drain {
     sleep_request: Option<u32>,
 }
 
-impl Drain {
+impl<W: WakeFigures + Copy> Drain<W> {
     /// Nothing processed yet, for a pipeline configured by `config` fed from a queue of
-    /// `queue_len` items.
-    pub fn new(config: &Config, queue_len: usize) -> Self {
+    /// `queue_len` items, sleeping as `sleep` says.
+    pub fn new(config: &Config, queue_len: usize, sleep: &SleepSettings<W>) -> Self {
         let status_every_samples = config.rate.samples_in_ms(STATUS_EVERY_MS);
         Drain {
             startup: Startup::new(config.rate, config.gyro),
             status_every_samples,
             samples: 0,
             next_status: status_every_samples,
-            policy: SleepPolicy::new(config.rate, &SLEEP),
+            policy: SleepPolicy::new(config.rate, sleep),
+            sleep: *sleep,
             queue_len,
             sleep_request: None,
         }
@@ -288,7 +296,7 @@ impl Drain {
                         log.startup(e, serial);
                     }
                 }
-                Item::Asleep => log.asleep(self.policy.still_samples(), &SLEEP, serial),
+                Item::Asleep => log.asleep(self.policy.still_samples(), &self.sleep, serial),
                 Item::Gap(_) | Item::Woke(_) => {}
             }
             let due = self.policy.after_item(
@@ -324,19 +332,19 @@ impl Drain {
 
 /// Starts the sensor, retrying once a second (and saying so on both outputs) while it does
 /// not answer: still powering up, or a loose wire.
-pub fn start_sensor<I, D>(
-    mut imu: Mpu6050<I, Unconfigured>,
+pub fn start_sensor<S, D>(
+    mut imu: S,
     mut delay: D,
-    config: mpu6050::Config,
     mode: ReadMode,
     serial: &mut impl Write,
-) -> ImuSampler<I, D>
+) -> ImuSampler<S, D>
 where
-    I: I2c + BusRecovery,
+    S: ImuSource,
+    S::Bus: BusRecovery,
     D: DelayNs,
 {
     loop {
-        match ImuSampler::start(imu, delay, config, mode) {
+        match ImuSampler::start(imu, delay, mode) {
             Ok(s) => return s,
             Err((i, d, e)) => {
                 report_not_ready(&e, serial);
@@ -349,19 +357,19 @@ where
 
 /// [`start_sensor`] for the async sampler ([`crate::imu_sampler::asynch`]): the same
 /// retries and reports, the waits awaited.
-pub async fn start_async_sensor<I, D>(
-    mut imu: gaitclip_mpu6050::asynch::Mpu6050<I, gaitclip_mpu6050::mode::Unconfigured>,
+pub async fn start_async_sensor<S, D>(
+    mut imu: S,
     mut delay: D,
-    config: mpu6050::Config,
     mode: ReadMode,
     serial: &mut impl Write,
-) -> crate::imu_sampler::asynch::ImuSampler<I, D>
+) -> crate::imu_sampler::asynch::ImuSampler<S, D>
 where
-    I: embedded_hal_async::i2c::I2c + BusRecovery,
+    S: gaitclip_imu::source::asynch::ImuSource,
+    S::Bus: BusRecovery,
     D: embedded_hal_async::delay::DelayNs,
 {
     loop {
-        match crate::imu_sampler::asynch::ImuSampler::start(imu, delay, config, mode).await {
+        match crate::imu_sampler::asynch::ImuSampler::start(imu, delay, mode).await {
             Ok(s) => return s,
             Err((i, d, e)) => {
                 report_not_ready(&e, serial);
@@ -375,12 +383,16 @@ where
 /// A failed start, on defmt (with the error) and the serial line.
 fn report_not_ready(e: &impl core::fmt::Debug, serial: &mut impl Write) {
     defmt::error!(
-        "MPU6050 not ready ({}): check the wiring; retrying",
+        "{=str} not ready ({}): check the wiring; retrying",
+        crate::live_settings::NAME,
         defmt::Debug2Format(e)
     );
     let _ = serial_line::comment(
         serial,
-        format_args!("MPU6050 not ready: check the wiring; retrying"),
+        format_args!(
+            "{} not ready: check the wiring; retrying",
+            crate::live_settings::NAME
+        ),
     );
 }
 

@@ -22,7 +22,7 @@ use gaitclip::detect::seam::StepDetector;
 use gaitclip::pipeline::config::Config;
 use gaitclip::pipeline::Pipeline;
 use gaitclip::sensor::rate::SampleRate;
-use gaitclip_mpu6050::blocking::Mpu6050;
+use gaitclip_mpu6050::blocking::{Mpu6050, Mpu6050Source};
 use gaitclip_mpu6050::{self as mpu6050, Address};
 use gaitclip_mpu6050::{AccelRange, GyroRange, SAMPLE_BYTES};
 use heapless::spsc::Queue;
@@ -69,15 +69,18 @@ pub const RATE: SampleRate = unwrap(SampleRate::from_millihertz(trace::RATE_MILL
 const ACCEL: AccelRange = unwrap(AccelRange::from_afs_sel(trace::ACCEL_AFS_SEL));
 const GYRO: GyroRange = unwrap(GyroRange::from_fs_sel(trace::GYRO_FS_SEL));
 /// The pipeline's configuration for the stored trace.
-pub const CONFIG: Config = crate::live_settings::config(RATE, ACCEL, GYRO);
+pub const CONFIG: Config = crate::live_settings::mpu6050::config(RATE, ACCEL, GYRO);
 /// The movement buffer: [`gaitclip::detect::seam::MAX_MOVEMENT_MS`] at the trace's rate.
 pub const MOVEMENT_SAMPLES: usize =
     gaitclip::detect::seam::movement_samples(trace::RATE_MILLIHERTZ.div_ceil(1000));
-const SENSOR: mpu6050::Config =
-    crate::live_settings::sensor_config((trace::RATE_MILLIHERTZ / 1000) as u16, ACCEL, GYRO);
+const SENSOR: mpu6050::Config = crate::live_settings::mpu6050::sensor_config(
+    (trace::RATE_MILLIHERTZ / 1000) as u16,
+    ACCEL,
+    GYRO,
+);
 
 /// Sampler, queue producer and pulse count, shared by the timer interrupt and the main loop.
-static LINK: SampleLink<ReplayMpu6050, SpinDelay> = SampleLink::new();
+static LINK: SampleLink<Mpu6050Source<ReplayMpu6050>, SpinDelay> = SampleLink::new();
 static TRACE_DONE: AtomicBool = AtomicBool::new(false);
 
 /// The board's sample timer.
@@ -130,9 +133,8 @@ pub fn run<D: StepDetector, T: SampleTimer>(
         Address::Ad0Low,
     );
     let sampler = match ImuSampler::start(
-        imu,
+        Mpu6050Source::new(imu, SENSOR),
         SpinDelay { cycles_per_us },
-        SENSOR,
         ReadMode::PerSample,
     ) {
         Ok(s) => s,

@@ -30,16 +30,43 @@ use gaitclip_mpu6050::{MotionThreshold, MotionThresholdUnit, MotionWakeConfig, W
 
 use crate::imu_sampler::Item;
 
-/// When and how the clip sleeps.
+/// When and how the clip sleeps, `W` the part's wait for motion (the MPU6050's by default).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub struct SleepSettings {
+pub struct SleepSettings<W = MotionWakeConfig> {
     /// Still this long (rest test true, no stride) before sleeping, ms.
     pub still_ms: u32,
     /// The sensor's wait for motion.
-    pub wake: MotionWakeConfig,
-    /// Samples dropped after waking while the gyro starts, ms (datasheet §6.1, gyroscope
-    /// start-up time: 30 ms typical).
+    pub wake: W,
+    /// Samples dropped after waking while the gyro starts, ms (the MPU6050's datasheet
+    /// §6.1, gyroscope start-up time: 30 ms typical).
     pub settle_ms: u32,
+}
+
+/// What the log says of a part's wait for motion.
+pub trait WakeFigures {
+    /// The accelerometer's rate while waiting, mHz.
+    fn millihertz(&self) -> u32;
+    /// The part's supply current while waiting, µA, where a cited datasheet gives it.
+    fn supply_ua(&self) -> Option<u32>;
+}
+
+impl WakeFigures for MotionWakeConfig {
+    fn millihertz(&self) -> u32 {
+        self.rate.millihertz()
+    }
+    fn supply_ua(&self) -> Option<u32> {
+        Some(self.rate.supply_ua())
+    }
+}
+
+impl WakeFigures for gaitclip_lsm6dsv320x::MotionWakeConfig {
+    fn millihertz(&self) -> u32 {
+        self.odr.millihertz()
+    }
+    /// `None`: the LSM6DSV320X datasheet's current table is not among the cited sources.
+    fn supply_ua(&self) -> Option<u32> {
+        None
+    }
 }
 
 /// The MOT_THR unit the boards configure for: the product specification's 32 mg per count
@@ -84,7 +111,7 @@ pub struct SleepPolicy {
 
 impl SleepPolicy {
     /// A policy for samples at `rate` with `settings`. A still period of 0 never sleeps.
-    pub const fn new(rate: SampleRate, settings: &SleepSettings) -> Self {
+    pub const fn new<W: Copy>(rate: SampleRate, settings: &SleepSettings<W>) -> Self {
         SleepPolicy {
             still_needed: rate.samples_in_ms(settings.still_ms),
             still: 0,
@@ -150,7 +177,7 @@ impl SleepPolicy {
     }
 
     /// Samples dropped after a wake-up while the gyro settles, at `rate`.
-    pub const fn settle_samples(rate: SampleRate, settings: &SleepSettings) -> u32 {
+    pub const fn settle_samples<W: Copy>(rate: SampleRate, settings: &SleepSettings<W>) -> u32 {
         rate.samples_in_ms(settings.settle_ms)
     }
 }

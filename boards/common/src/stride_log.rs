@@ -15,7 +15,7 @@ use gaitclip::sensor::rate::SampleRate;
 
 use crate::imu_sampler::Counters;
 use crate::serial_line;
-use crate::sleep::SleepSettings;
+use crate::sleep::{SleepSettings, WakeFigures};
 use crate::startup::StartupEvent;
 
 /// A serial output that discards everything (boards without a UART).
@@ -177,24 +177,45 @@ impl StrideLog {
 
     /// Reports that the sensor went to its low-power wait for motion, still for
     /// `still_samples` samples.
-    pub fn asleep(&self, still_samples: u32, settings: &SleepSettings, serial: &mut impl Write) {
+    pub fn asleep<W: WakeFigures>(
+        &self,
+        still_samples: u32,
+        settings: &SleepSettings<W>,
+        serial: &mut impl Write,
+    ) {
         let still_ms = self.rate.ms_of_samples(still_samples);
-        let wake = settings.wake.rate;
-        defmt::info!(
-            "sleep: still for {=u32} ms; sensor waits for motion at {=u32} mHz ({=u32} uA), MCU sleeps",
-            still_ms,
-            wake.millihertz(),
-            wake.supply_ua()
-        );
-        let _ = serial_line::comment(
-            serial,
-            format_args!(
-                "sleep still_ms={} wake_mhz={} sensor_ua={}: waiting for motion",
-                still_ms,
-                wake.millihertz(),
-                wake.supply_ua()
-            ),
-        );
+        let wake_mhz = settings.wake.millihertz();
+        match settings.wake.supply_ua() {
+            Some(ua) => {
+                defmt::info!(
+                    "sleep: still for {=u32} ms; sensor waits for motion at {=u32} mHz ({=u32} uA), MCU sleeps",
+                    still_ms,
+                    wake_mhz,
+                    ua
+                );
+                let _ = serial_line::comment(
+                    serial,
+                    format_args!(
+                        "sleep still_ms={} wake_mhz={} sensor_ua={}: waiting for motion",
+                        still_ms, wake_mhz, ua
+                    ),
+                );
+            }
+            None => {
+                defmt::info!(
+                    "sleep: still for {=u32} ms; sensor waits for motion at {=u32} mHz, MCU sleeps",
+                    still_ms,
+                    wake_mhz
+                );
+                let _ = serial_line::comment(
+                    serial,
+                    format_args!(
+                        "sleep still_ms={} wake_mhz={}: waiting for motion",
+                        still_ms, wake_mhz
+                    ),
+                );
+            }
+        }
     }
 
     /// Reports the wake-up on motion: `periods` sample periods were not sampled (asleep,

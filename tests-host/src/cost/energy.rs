@@ -18,7 +18,7 @@
 
 use std::fmt::Write as _;
 
-use gaitclip_board::live_settings::{FIFO_BATCH, RATE_HZ};
+use gaitclip_board::live_settings::mpu6050::{FIFO_BATCH, RATE_HZ};
 use gaitclip_board::sleep::SLEEP;
 use gaitclip_mpu6050::WakeRate;
 

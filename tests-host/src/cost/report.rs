@@ -124,10 +124,13 @@ pub struct Build {
     pub machine: Option<&'static str>,
     /// The step detector it is built with (see [`build_for`]).
     pub detector: Detector,
+    /// A feature that builds it with another sensor (into `target/<feature>`, as the test
+    /// command builds the boards' variants), or `None` for the MPU6050.
+    pub sensor: Option<&'static str>,
 }
 
 /// The firmware builds whose size is reported.
-pub const BUILDS: [Build; 7] = [
+pub const BUILDS: [Build; 11] = [
     Build {
         label: "mps2-an386 (QEMU, M4F)",
         dir: "boards/mps2-an386",
@@ -135,6 +138,7 @@ pub const BUILDS: [Build; 7] = [
         target: "thumbv7em-none-eabihf",
         machine: Some(qemu::MACHINE_M4),
         detector: Detector::Cycle,
+        sensor: None,
     },
     Build {
         label: "mps2-an386 (QEMU, M4F), peak-valley detector",
@@ -143,6 +147,7 @@ pub const BUILDS: [Build; 7] = [
         target: "thumbv7em-none-eabihf",
         machine: Some(qemu::MACHINE_M4),
         detector: Detector::PeakValley,
+        sensor: None,
     },
     Build {
         label: "microbit (QEMU, M0)",
@@ -151,6 +156,7 @@ pub const BUILDS: [Build; 7] = [
         target: "thumbv6m-none-eabi",
         machine: Some(qemu::MACHINE_M0),
         detector: Detector::Cycle,
+        sensor: None,
     },
     Build {
         label: "microbit (QEMU, M0), peak-valley detector",
@@ -159,6 +165,7 @@ pub const BUILDS: [Build; 7] = [
         target: "thumbv6m-none-eabi",
         machine: Some(qemu::MACHINE_M0),
         detector: Detector::PeakValley,
+        sensor: None,
     },
     Build {
         label: "nrf52840-dk (M4F)",
@@ -167,6 +174,7 @@ pub const BUILDS: [Build; 7] = [
         target: "thumbv7em-none-eabihf",
         machine: None,
         detector: Detector::Cycle,
+        sensor: None,
     },
     Build {
         label: "nRF52840-DK + Bluetooth RSC foot pod (trouble-host, SoftDevice Controller)",
@@ -175,6 +183,7 @@ pub const BUILDS: [Build; 7] = [
         target: "thumbv7em-none-eabihf",
         machine: None,
         detector: Detector::Cycle,
+        sensor: None,
     },
     Build {
         label: "rp-pico (M0+)",
@@ -183,6 +192,42 @@ pub const BUILDS: [Build; 7] = [
         target: "thumbv6m-none-eabi",
         machine: None,
         detector: Detector::Cycle,
+        sensor: None,
+    },    Build {
+        label: "mps2-an386 (QEMU, M4F), LSM6DSV320X sprint replay",
+        dir: "boards/mps2-an386",
+        bin: "mps2-an386",
+        target: "thumbv7em-none-eabihf",
+        machine: Some(qemu::MACHINE_M4),
+        detector: Detector::Cycle,
+        sensor: Some("replay-lsm6dsv320x"),
+    },
+    Build {
+        label: "nrf52840-dk (M4F), LSM6DSV320X",
+        dir: "boards/nrf52840-dk",
+        bin: "nrf52840-dk",
+        target: "thumbv7em-none-eabihf",
+        machine: None,
+        detector: Detector::Cycle,
+        sensor: Some("lsm6dsv320x"),
+    },
+    Build {
+        label: "nRF52840-DK + Bluetooth RSC foot pod, LSM6DSV320X",
+        dir: "boards/nrf52840-ble",
+        bin: "nrf52840-ble",
+        target: "thumbv7em-none-eabihf",
+        machine: None,
+        detector: Detector::Cycle,
+        sensor: Some("lsm6dsv320x"),
+    },
+    Build {
+        label: "rp-pico (M0+), LSM6DSV320X",
+        dir: "boards/rp-pico",
+        bin: "rp-pico",
+        target: "thumbv6m-none-eabi",
+        machine: None,
+        detector: Detector::Cycle,
+        sensor: Some("lsm6dsv320x"),
     },
 ];
 
@@ -280,7 +325,19 @@ pub fn report(inp: &Inputs) -> Result<String> {
         let (label, machine) = (b.label, b.machine);
         bar.set_message(format!("size of {label}"));
         bar.inc(1);
-        let elf = build_for(b.dir, b.bin, b.target, b.detector, &[])?;
+        let elf = match b.sensor {
+            None => build_for(b.dir, b.bin, b.target, b.detector, &[])?,
+            Some(feature) => {
+                let dir = format!("target/{feature}");
+                crate::cost::firmware::build_with(
+                    b.dir,
+                    b.bin,
+                    b.target,
+                    &["--features", feature],
+                    &[("CARGO_TARGET_DIR", dir.as_ref())],
+                )?
+            }
+        };
         let size = size_of_elf(&std::fs::read(&elf)?)?;
         let stack = match machine {
             Some(m) => {

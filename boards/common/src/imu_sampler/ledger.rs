@@ -3,7 +3,6 @@
 //! transfers and report each outcome here, so the two samplers cannot count differently.
 
 use gaitclip::sensor::sample::RawSample;
-use gaitclip_mpu6050::MotionWakeConfig;
 
 use super::{Counters, Item, ReadMode, FIFO_BURST, RESTART_AFTER};
 
@@ -20,7 +19,7 @@ pub(crate) enum Due {
 }
 
 /// The sampler's state apart from the driver.
-pub(crate) struct Ledger {
+pub(crate) struct Ledger<W> {
     mode: ReadMode,
     /// Data-ready pulses whose sample is still in the FIFO (FIFO mode).
     unread: u32,
@@ -33,7 +32,7 @@ pub(crate) struct Ledger {
     /// settles (what a sleep request counts).
     read: u32,
     /// Go to the low-power wait once this many samples have been read, with these settings.
-    sleep_request: Option<(u32, MotionWakeConfig)>,
+    sleep_request: Option<(u32, W)>,
     /// Samples still to drop after waking while the gyro settles.
     settling: u32,
     /// Periods unsampled since the sensor went to sleep, not yet handed over as
@@ -41,7 +40,7 @@ pub(crate) struct Ledger {
     pending_woke: u32,
 }
 
-impl Ledger {
+impl<W: Copy> Ledger<W> {
     /// Nothing read, nothing lost.
     pub(crate) const fn new(mode: ReadMode) -> Self {
         Ledger {
@@ -69,7 +68,7 @@ impl Ledger {
         self.read
     }
 
-    pub(crate) fn request_sleep(&mut self, after: u32, wake: MotionWakeConfig) {
+    pub(crate) fn request_sleep(&mut self, after: u32, wake: W) {
         self.sleep_request = Some((after, wake));
     }
 
@@ -87,12 +86,21 @@ impl Ledger {
                     Due::Nothing
                 }
             }
+            ReadMode::Watermark { samples } => {
+                self.unread = self.unread.saturating_add(samples.max(1) as u32);
+                // Read until the FIFO is empty: INT1 stays high while it holds its
+                // watermark, so a FIFO left above it would never pulse again. One burst more
+                // than the pulses account for, for what arrived meanwhile.
+                Due::Fifo {
+                    bursts: self.unread as usize / FIFO_BURST + 2,
+                }
+            }
         }
     }
 
     /// After a pulse's reads: the motion-wait settings if the requested sleep is due now
     /// (the request is taken).
-    pub(crate) fn sleep_due(&mut self) -> Option<MotionWakeConfig> {
+    pub(crate) fn sleep_due(&mut self) -> Option<W> {
         match self.sleep_request {
             Some((at, wake)) if self.read >= at => {
                 self.sleep_request = None;
@@ -137,7 +145,13 @@ impl Ledger {
                 self.emit(push, Item::Sample(*s));
             }
         }
-        if samples.len() < FIFO_BURST {
+        let drained = match self.mode {
+            // A watermark read goes on until a read brings nothing (the part may hold back
+            // a period it is still assembling, and an error may follow a short burst).
+            ReadMode::Watermark { .. } => samples.is_empty(),
+            _ => samples.len() < FIFO_BURST,
+        };
+        if drained {
             // Pulses counted but not in the FIFO: none are waiting any more.
             self.unread = 0;
             return false;

@@ -1,10 +1,12 @@
 //! The sensor side of every board: what the data-ready interrupt does.
 //!
-//! Each board calls [`ImuSampler::on_data_ready`] from the interrupt of the MPU6050's INT
-//! pin (the emulated boards from a timer standing in for it). The sampler reads the sensor,
-//! either one 14-byte burst per data-ready ([`ReadMode::PerSample`]) or the FIFO every few
-//! pulses ([`ReadMode::Fifo`], fewer bus transactions and wake-ups of the I2C peripheral),
-//! and hands [`Item`]s to the board's queue. Nothing is lost silently:
+//! Each board calls [`ImuSampler::on_data_ready`] from the interrupt of the sensor's INT
+//! pin (the emulated boards from a timer standing in for it). The sampler reads the sensor
+//! through its driver crate's source ([`gaitclip_imu::source`]: the MPU6050's, the
+//! LSM6DSV320X's), either one sample per data-ready ([`ReadMode::PerSample`]), the FIFO every
+//! few pulses ([`ReadMode::Fifo`], fewer bus transactions and wake-ups of the I2C
+//! peripheral), or the FIFO at its watermark ([`ReadMode::Watermark`]), and hands [`Item`]s
+//! to the board's queue. Nothing is lost silently:
 //!
 //! - a failed read is counted and retried at once, [`RETRIES`] times;
 //! - a sample period whose read still fails becomes part of a [`Item::Gap`] (per-sample
@@ -24,7 +26,7 @@
 //! tests that drive one with `embedded-hal-mock` hold for the other (tests-host's
 //! `bus_faults` runs every scenario through both).
 //!
-//! Board glue, shared: generic over the bus and delay.
+//! Board glue, shared: generic over the part, its bus and the delay.
 
 mod ledger;
 mod sampler;
@@ -37,6 +39,9 @@ use gaitclip::detect::seam::StepDetector;
 use gaitclip::pipeline::Pipeline;
 use gaitclip::record::stride::Stride;
 use gaitclip::sensor::sample::RawSample;
+/// How the sensor is read: per sample, the FIFO every few pulses, or the FIFO at its
+/// watermark (the seam's, so that each part's source can refuse what it cannot do).
+pub use gaitclip_imu::source::ReadMode;
 
 /// Immediate retries of a failed read.
 pub const RETRIES: u32 = 2;
@@ -74,19 +79,6 @@ impl Item {
             Item::Asleep => None,
         }
     }
-}
-
-/// How the sensor is read.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum ReadMode {
-    /// INT latched on data ready; every pulse reads the 14 data registers.
-    PerSample,
-    /// INT pulses on data ready and is only counted; every `batch` pulses the FIFO is read
-    /// in one burst (at most [`FIFO_BURST`] samples).
-    Fifo {
-        /// Pulses per FIFO read (1..=[`FIFO_BURST`]).
-        batch: u8,
-    },
 }
 
 /// A board's way to free a stuck I2C bus.

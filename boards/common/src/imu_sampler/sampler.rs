@@ -1,9 +1,10 @@
 //! The sampler on the bus, written once: `maybe-async-cfg` makes [`blocking`] (on
-//! [`embedded_hal::i2c::I2c`], which the bare-metal boards call from their data-ready
-//! interrupt) and [`asynch`] (on [`embedded_hal_async::i2c::I2c`], each transfer and the
-//! reset's waits awaited, so an executor such as embassy's sleeps the core while the bytes
-//! move instead of spinning in the data-ready task) from the same source. Both report to one
-//! ledger (`imu_sampler::ledger`).
+//! [`gaitclip_imu::source::blocking::ImuSource`], which the bare-metal boards call from their
+//! data-ready interrupt) and [`asynch`] (on [`gaitclip_imu::source::asynch::ImuSource`], each
+//! transfer and the reset's waits awaited, so an executor such as embassy's sleeps the core
+//! while the bytes move instead of spinning in the data-ready task) from the same source. Both
+//! report to one ledger (`imu_sampler::ledger`). Neither knows which part it drives: the
+//! driver crates implement the source traits.
 
 #[maybe_async_cfg::maybe(
     idents(
@@ -13,91 +14,42 @@
     sync(self = "blocking"),
     async(self = "asynch")
 )]
-/// The sampler over the MPU6050's driver: `ImuSampler`.
+/// The sampler over any part's source: `ImuSampler`.
 pub mod driver {
     use embedded_hal_async::delay::DelayNs;
-    use embedded_hal_async::i2c::I2c;
     use gaitclip::sensor::sample::RawSample;
-    use gaitclip_mpu6050::asynch::Mpu6050;
-    use gaitclip_mpu6050::mode::{MotionWake, Sampling, Unconfigured};
-    use gaitclip_mpu6050::{self as mpu6050, MotionWakeConfig};
+    use gaitclip_imu::source::asynch::ImuSource;
 
     use crate::imu_sampler::ledger::{Due, Ledger};
     use crate::imu_sampler::{BusRecovery, Counters, Item, ReadMode, FIFO_BURST, RETRIES};
 
-    /// The driver in the mode the sampler last brought it to (the driver's modes are types; the
-    /// sampler switches between them at run time).
-    enum Sensor<I> {
-        Sampling(Mpu6050<I, Sampling>),
-        Waiting(Mpu6050<I, MotionWake>),
-    }
-
-    impl<I: I2c> Sensor<I> {
-        fn bus_mut(&mut self) -> &mut I {
-            match self {
-                Sensor::Sampling(d) => d.bus_mut(),
-                Sensor::Waiting(d) => d.bus_mut(),
-            }
-        }
-
-        /// Resets the part into sampling from either mode ([`Mpu6050::init`]); on failure the
-        /// driver stays in the mode it was.
-        async fn init<D: DelayNs>(
-            self,
-            delay: &mut D,
-            config: &mpu6050::Config,
-        ) -> (Self, Result<(), mpu6050::Error<I::Error>>) {
-            let r = match self {
-                Sensor::Sampling(d) => d
-                    .init(delay, config)
-                    .await
-                    .map_err(|e| (Sensor::Sampling(e.dev), e.error)),
-                Sensor::Waiting(d) => d
-                    .init(delay, config)
-                    .await
-                    .map_err(|e| (Sensor::Waiting(e.dev), e.error)),
-            };
-            match r {
-                Ok(d) => (Sensor::Sampling(d), Ok(())),
-                Err((s, e)) => (s, Err(e)),
-            }
-        }
-    }
-
-    /// The sensor, its settings and the fault bookkeeping, on the bus.
-    pub struct ImuSampler<I, D> {
-        /// Always `Some` between calls: taken only while a mode change moves the driver.
-        imu: Option<Sensor<I>>,
+    /// The part, its read mode and the fault bookkeeping, on the bus.
+    pub struct ImuSampler<S: ImuSource, D> {
+        imu: S,
         delay: D,
-        config: mpu6050::Config,
-        ledger: Ledger,
+        ledger: Ledger<S::Wake>,
     }
 
-    impl<I, D> ImuSampler<I, D>
+    impl<S, D> ImuSampler<S, D>
     where
-        I: I2c + BusRecovery,
+        S: ImuSource,
+        S::Bus: BusRecovery,
         D: DelayNs,
     {
-        /// Initialises the sensor for `config` and its interrupt for `mode`. On error the bus
-        /// and delay are handed back with it, for the board to report and retry.
+        /// Resets the part into sampling and sets its interrupt up for `mode`. On error the
+        /// part and delay are handed back with it, for the board to report and retry.
         #[allow(clippy::type_complexity)]
         pub async fn start(
-            imu: Mpu6050<I, Unconfigured>,
+            mut imu: S,
             mut delay: D,
-            config: mpu6050::Config,
             mode: ReadMode,
-        ) -> Result<Self, (Mpu6050<I, Unconfigured>, D, mpu6050::Error<I::Error>)> {
-            let mut imu = match imu.init(&mut delay, &config).await {
-                Ok(imu) => imu,
-                Err(e) => return Err((e.dev, delay, e.error)),
-            };
-            if let Err(e) = enable_interrupt(&mut imu, mode).await {
-                return Err((imu.into_unconfigured(), delay, e));
+        ) -> Result<Self, (S, D, S::Error)> {
+            if let Err(e) = imu.restart(&mut delay, mode).await {
+                return Err((imu, delay, e));
             }
             Ok(ImuSampler {
-                imu: Some(Sensor::Sampling(imu)),
+                imu,
                 delay,
-                config,
                 ledger: Ledger::new(mode),
             })
         }
@@ -105,6 +57,11 @@ pub mod driver {
         /// The fault counters.
         pub const fn counters(&self) -> Counters {
             self.ledger.counters()
+        }
+
+        /// The part's source (for what it counts of its own, such as a merge's).
+        pub const fn source(&self) -> &S {
+            &self.imu
         }
 
         /// The data-ready interrupt: reads what is due and hands it to `push` (which returns
@@ -132,45 +89,28 @@ pub mod driver {
         }
 
         /// Whether the sensor is in its low-power wait for motion.
-        pub const fn asleep(&self) -> bool {
-            matches!(self.imu, Some(Sensor::Waiting(_)))
+        pub fn asleep(&self) -> bool {
+            self.imu.asleep()
         }
 
-        /// Sends the sensor to its low-power wait for motion ([`Mpu6050::enter_motion_wake`])
+        /// Sends the sensor to its low-power wait for motion ([`ImuSource::enter_motion_wake`])
         /// once `after` samples have been handed on in all ([`ImuSampler::samples_read`]). The main
         /// loop decides on what it has processed, while the interrupt may have read a few more:
         /// it asks for a count ahead of anything the queue can hold, so the sleep falls after
         /// the same sample however far behind it ran (the replay's host model relies on it).
         /// Replaces an earlier request.
-        pub fn request_sleep(&mut self, after: u32, wake: MotionWakeConfig) {
+        pub fn request_sleep(&mut self, after: u32, wake: S::Wake) {
             self.ledger.request_sleep(after, wake);
         }
 
-        async fn enter_sleep(
-            &mut self,
-            wake: &MotionWakeConfig,
-            push: &mut impl FnMut(Item) -> bool,
-        ) {
+        async fn enter_sleep(&mut self, wake: &S::Wake, push: &mut impl FnMut(Item) -> bool) {
             for _ in 0..=RETRIES {
-                let entered = match self.imu.take() {
-                    Some(Sensor::Sampling(d)) => {
-                        match d.enter_motion_wake(wake, self.config.accel).await {
-                            Ok(d) => {
-                                self.imu = Some(Sensor::Waiting(d));
-                                true
-                            }
-                            Err(e) => {
-                                self.imu = Some(Sensor::Sampling(e.dev));
-                                false
-                            }
-                        }
-                    }
-                    other => {
-                        self.imu = other;
-                        false
-                    }
-                };
-                if entered {
+                if self
+                    .imu
+                    .enter_motion_wake(&mut self.delay, wake)
+                    .await
+                    .is_ok()
+                {
                     self.ledger.asleep(push);
                     return;
                 }
@@ -182,10 +122,11 @@ pub mod driver {
         }
 
         /// The INT pin rose while asleep: motion. Back to full sampling
-        /// ([`Mpu6050::leave_motion_wake`], then the interrupt and FIFO as at start), dropping the first
-        /// `settle` samples (the gyro's start-up, datasheet §6.1: 30 ms); `slept` sample periods
-        /// passed while asleep (the board's low-power clock). Both become one [`Item::Woke`]
-        /// before the first sample kept. On a bus error the sensor is set up again from reset.
+        /// ([`ImuSource::leave_motion_wake`], with the interrupt and FIFO as at start), dropping
+        /// the first `settle` samples (the gyro's start-up: 30 ms on the MPU6050, datasheet
+        /// §6.1); `slept` sample periods passed while asleep (the board's low-power clock).
+        /// Both become one [`Item::Woke`] before the first sample kept. On a bus error the
+        /// sensor is set up again from reset.
         pub async fn on_motion(
             &mut self,
             slept: u32,
@@ -198,7 +139,13 @@ pub mod driver {
             self.ledger.motion(slept, settle);
             let mut resumed = false;
             for _ in 0..=RETRIES {
-                if self.resume().await {
+                let mode = self.ledger.mode();
+                if self
+                    .imu
+                    .leave_motion_wake(&mut self.delay, mode)
+                    .await
+                    .is_ok()
+                {
                     resumed = true;
                     break;
                 }
@@ -210,26 +157,10 @@ pub mod driver {
             self.ledger.resumed(push);
         }
 
-        /// Leaves the motion wait (if still in it: a retry after the interrupt's setup failed
-        /// is already sampling) and sets the interrupt up again.
-        async fn resume(&mut self) -> bool {
-            match self.imu.take() {
-                Some(Sensor::Waiting(d)) => match d.leave_motion_wake(&self.config).await {
-                    Ok(d) => self.imu = Some(Sensor::Sampling(d)),
-                    Err(e) => {
-                        self.imu = Some(Sensor::Waiting(e.dev));
-                        return false;
-                    }
-                },
-                other => self.imu = other,
-            }
-            self.enable_interrupt().await
-        }
-
         /// The bus, for a board's emulated sensor (its clock in the low-power wait) and tests;
         /// `None` only inside a mode change, which no caller can see.
-        pub fn bus_mut(&mut self) -> Option<&mut I> {
-            self.imu.as_mut().map(Sensor::bus_mut)
+        pub fn bus_mut(&mut self) -> Option<&mut S::Bus> {
+            self.imu.bus_mut()
         }
 
         /// The board's watchdog found no data-ready pulse for `periods` sample periods: the
@@ -246,14 +177,9 @@ pub mod driver {
 
         async fn read_one(&mut self, push: &mut impl FnMut(Item) -> bool) {
             for _ in 0..=RETRIES {
-                let read = match &mut self.imu {
-                    Some(Sensor::Sampling(d)) => d.read_sample().await.ok(),
-                    // Never here while awake; a read that cannot happen fails like a bus error.
-                    _ => None,
-                };
-                match read {
-                    Some(s) => return self.ledger.sample(s, push),
-                    None => self.ledger.bus_error(),
+                match self.imu.read_sample().await {
+                    Ok(s) => return self.ledger.sample(s, push),
+                    Err(_) => self.ledger.bus_error(),
                 }
             }
             if self.ledger.sample_missed() {
@@ -265,20 +191,14 @@ pub mod driver {
             let mut buf = [RawSample::default(); FIFO_BURST];
             let mut attempts = 0;
             while bursts > 0 {
-                let read = match &mut self.imu {
-                    Some(Sensor::Sampling(d)) => d.read_fifo(&mut buf).await.map_err(Some),
-                    _ => Err(None),
-                };
-                match read {
+                match self.imu.read_fifo(&mut buf).await {
                     Ok(n) => {
                         if !self.ledger.fifo_read(&buf[..n.min(FIFO_BURST)], push) {
                             return;
                         }
                         bursts -= 1;
                     }
-                    Err(Some(mpu6050::Error::FifoOverflow | mpu6050::Error::FifoMisaligned(_))) => {
-                        return self.ledger.fifo_overflowed();
-                    }
+                    Err(e) if S::overflowed(&e) => return self.ledger.fifo_overflowed(),
                     Err(_) => {
                         self.ledger.bus_error();
                         attempts += 1;
@@ -297,42 +217,10 @@ pub mod driver {
         /// Recovers the bus and sets the sensor up again; on failure the next failed period
         /// tries again.
         async fn restart(&mut self) {
-            let recovered = self.imu.as_mut().is_some_and(|s| s.bus_mut().recover_bus());
-            let set_up = self.setup().await;
+            let recovered = self.imu.bus_mut().is_some_and(|b| b.recover_bus());
+            let mode = self.ledger.mode();
+            let set_up = self.imu.restart(&mut self.delay, mode).await.is_ok();
             self.ledger.restarted(recovered, set_up);
-        }
-
-        /// Resets the sensor into sampling (a reset sensor is awake whatever it was doing) and
-        /// sets its interrupt up; whether both worked.
-        async fn setup(&mut self) -> bool {
-            let Some(sensor) = self.imu.take() else {
-                return false;
-            };
-            let (sensor, reset) = sensor.init(&mut self.delay, &self.config).await;
-            self.imu = Some(sensor);
-            reset.is_ok() && self.enable_interrupt().await
-        }
-
-        /// Sets the data-ready interrupt up for the read mode; false if that failed (or the
-        /// sensor is not sampling).
-        async fn enable_interrupt(&mut self) -> bool {
-            match &mut self.imu {
-                Some(Sensor::Sampling(d)) => enable_interrupt(d, self.ledger.mode()).await.is_ok(),
-                _ => false,
-            }
-        }
-    }
-
-    async fn enable_interrupt<I: I2c>(
-        d: &mut Mpu6050<I, Sampling>,
-        mode: ReadMode,
-    ) -> Result<(), mpu6050::Error<I::Error>> {
-        match mode {
-            ReadMode::PerSample => d.enable_data_ready_interrupt().await,
-            ReadMode::Fifo { .. } => {
-                d.enable_fifo().await?;
-                d.enable_data_ready_pulse().await
-            }
         }
     }
 }

@@ -1,11 +1,23 @@
-//! The sensor settings every board with a real MPU6050 runs: one place, so that the
+//! The MPU6050's settings on every board with a real one: one place, so that the
 //! nRF52840, Bluetooth and Pico builds measure the same way and the energy budget
 //! (`gaitclip cost`) reads the same figures the firmware uses.
 
 use gaitclip::pipeline::config::Config;
 use gaitclip::sensor::rate::SampleRate;
 use gaitclip_mpu6050 as mpu6050;
-use gaitclip_mpu6050::{AccelRange, GyroRange};
+use gaitclip_mpu6050::{AccelRange, Address, GyroRange, MotionWakeConfig};
+
+use crate::imu_sampler::ReadMode;
+use crate::sleep::SleepSettings;
+
+/// The part, for the logs.
+pub const NAME: &str = "MPU6050";
+/// The blocking sampler's handle on a bus `I`.
+pub type Source<I> = mpu6050::blocking::Mpu6050Source<I>;
+/// The async sampler's handle on a bus `I`.
+pub type AsyncSource<I> = mpu6050::asynch::Mpu6050Source<I>;
+/// Where the part sits on the bus: AD0 to ground.
+pub const ADDRESS: Address = Address::Ad0Low;
 
 /// Output data rate of the sensor, Hz.
 pub const RATE_HZ: u16 = 200;
@@ -25,6 +37,20 @@ pub const RATE: SampleRate = sample_rate(RATE_HZ);
 pub const SENSOR: mpu6050::Config = sensor_config(RATE_HZ, ACCEL, GYRO);
 /// The pipeline's configuration.
 pub const CONFIG: Config = config(RATE, ACCEL, GYRO);
+/// How the sampler reads it: the FIFO every [`FIFO_BATCH`] data-ready pulses.
+pub const MODE: ReadMode = ReadMode::Fifo { batch: FIFO_BATCH };
+/// When it sleeps and how it wakes ([`crate::sleep::SLEEP`]).
+pub const SLEEP: SleepSettings<MotionWakeConfig> = crate::sleep::SLEEP;
+
+/// The blocking sampler's handle on `bus`, with [`SENSOR`].
+pub fn source<I: embedded_hal::i2c::I2c>(bus: I) -> Source<I> {
+    Source::new(mpu6050::blocking::Mpu6050::new(bus, ADDRESS), SENSOR)
+}
+
+/// The async sampler's handle on `bus`, with [`SENSOR`].
+pub fn async_source<I: embedded_hal_async::i2c::I2c>(bus: I) -> AsyncSource<I> {
+    AsyncSource::new(mpu6050::asynch::Mpu6050::new(bus, ADDRESS), SENSOR)
+}
 
 /// The pipeline's configuration for samples at `rate` in the given ranges, with the
 /// firmware's [`crate::DETECTOR`].
