@@ -77,11 +77,7 @@ pub mod driver {
             delay: &mut D,
             config: &Config,
         ) -> Result<Lsm6dsv320x<I, Sampling>, ModeChangeError<I::Error, Self>> {
-            let mut result = self.run(&program::init(config), delay).await;
-            if result.is_ok() {
-                result = self.run(&program::enable_fifo(config), delay).await;
-            }
-            match result {
+            match init_bus(&mut self.bus, delay, config).await {
                 Ok(()) => Ok(self.into_mode()),
                 Err(error) => Err(ModeChangeError { error, dev: self }),
             }
@@ -106,6 +102,20 @@ pub mod driver {
         ) -> Result<(), Error<I::Error>> {
             Ok(self.bus.run(steps, delay, IDENTITY).await?)
         }
+    }
+
+    /// [`program::init`] then [`program::enable_fifo`] on the bus, shared by `init` from
+    /// every mode (one copy of the programs' work whatever modes a caller resets from).
+    #[inline(never)]
+    async fn init_bus<I: I2c, D: DelayNs>(
+        bus: &mut RegisterBus<I>,
+        delay: &mut D,
+        config: &Config,
+    ) -> Result<(), Error<I::Error>> {
+        bus.run(&program::init(config), delay, IDENTITY).await?;
+        Ok(bus
+            .run(&program::enable_fifo(config), delay, IDENTITY)
+            .await?)
     }
 
     impl<I: I2c> Lsm6dsv320x<I, Sampling> {

@@ -83,7 +83,7 @@ pub mod driver {
             delay: &mut D,
             config: &Config,
         ) -> Result<Mpu6050<I, Sampling>, ModeChangeError<I::Error, Self>> {
-            match self.run(&program::init(config), delay).await {
+            match init_bus(&mut self.bus, delay, config).await {
                 Ok(()) => Ok(self.into_mode()),
                 Err(error) => Err(ModeChangeError { error, dev: self }),
             }
@@ -110,6 +110,17 @@ pub mod driver {
         ) -> Result<(), Error<I::Error>> {
             Ok(self.bus.run(steps, delay, IDENTITY).await?)
         }
+    }
+
+    /// [`program::init`] on the bus, shared by `init` from every mode (one copy of the
+    /// program's work whatever modes a caller resets from).
+    #[inline(never)]
+    async fn init_bus<I: I2c, D: DelayNs>(
+        bus: &mut RegisterBus<I>,
+        delay: &mut D,
+        config: &Config,
+    ) -> Result<(), Error<I::Error>> {
+        Ok(bus.run(&program::init(config), delay, IDENTITY).await?)
     }
 
     impl<I: I2c> Mpu6050<I, Sampling> {
