@@ -46,30 +46,38 @@ fn wrong_address_does_not_answer() {
     );
 }
 
-/// The emulated LSM6DSV320X of the QEMU board, driven by the real driver on the host: it
-/// fills its FIFO a period per tick only as configured, the driver reads the words in order,
-/// and words left beyond the FIFO's capacity are an overrun the driver reports after emptying
-/// the FIFO, with the part's clock still counting.
-#[test]
-fn the_emulated_lsm6dsv320x_serves_its_fifo_and_overruns_as_the_part_does() {
-    use gaitclip_board::replay_lsm6dsv320x::{Recorded, ReplayLsm6dsv320x};
+/// The stored sprint's FIFO words (`fixtures/sprint_40g.lsm6dsv320x`) and how they were
+/// recorded, for the emulated LSM6DSV320X.
+fn sprint_fifo() -> (&'static [u8], gaitclip_board::replay_lsm6dsv320x::Recorded) {
     use gaitclip_host::sim::sprint::{LSM_ACCEL, LSM_GYRO, LSM_HIGH_G, LSM_WORDS_PER_SAMPLE};
-    use gaitclip_lsm6dsv320x::blocking::Lsm6dsv320x;
-    use gaitclip_lsm6dsv320x::fifo::{FifoWord, Tag, WORD_BYTES};
-    use gaitclip_lsm6dsv320x::{Address as LsmAddress, Config as LsmConfig, HighGOdr, Odr};
-
+    use gaitclip_lsm6dsv320x::{HighGOdr, Odr};
     let bytes: &'static [u8] = std::fs::read(
         std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../fixtures/sprint_40g.lsm6dsv320x"),
     )
     .unwrap()
     .leak();
-    let recorded = Recorded {
+    let recorded = gaitclip_board::replay_lsm6dsv320x::Recorded {
         odr_field: Odr::Hz240.field(),
         fs_xl: LSM_ACCEL.field(),
         fs_g: LSM_GYRO.field(),
         high_g_ctrl: LSM_HIGH_G.field() | (HighGOdr::Hz960.field() << 3),
         words_per_period: LSM_WORDS_PER_SAMPLE,
     };
+    (bytes, recorded)
+}
+
+/// The emulated LSM6DSV320X of the QEMU board, driven by the real driver on the host: it
+/// fills its FIFO a period per tick only as configured, the driver reads the words in order,
+/// and words left beyond the FIFO's capacity are an overrun the driver reports after emptying
+/// the FIFO, with the part's clock still counting.
+#[test]
+fn the_emulated_lsm6dsv320x_serves_its_fifo_and_overruns_as_the_part_does() {
+    use gaitclip_board::replay_lsm6dsv320x::ReplayLsm6dsv320x;
+    use gaitclip_lsm6dsv320x::blocking::Lsm6dsv320x;
+    use gaitclip_lsm6dsv320x::fifo::{FifoWord, Tag, WORD_BYTES};
+    use gaitclip_lsm6dsv320x::{Address as LsmAddress, Config as LsmConfig, Odr};
+
+    let (bytes, recorded) = sprint_fifo();
     let word =
         |i: usize| FifoWord::from_bytes(bytes[i * WORD_BYTES..][..WORD_BYTES].try_into().unwrap());
     let blank = FifoWord {
@@ -179,23 +187,10 @@ fn lsm_live(
 ) {
     use gaitclip_board::imu_sampler::ImuSampler;
     use gaitclip_board::live_settings::lsm6dsv320x as settings;
-    use gaitclip_board::replay_lsm6dsv320x::{Recorded, ReplayLsm6dsv320x};
-    use gaitclip_host::sim::sprint::{LSM_ACCEL, LSM_GYRO, LSM_HIGH_G, LSM_WORDS_PER_SAMPLE};
+    use gaitclip_board::replay_lsm6dsv320x::ReplayLsm6dsv320x;
     use gaitclip_lsm6dsv320x::blocking::{Lsm6dsv320x, Lsm6dsv320xSource};
-    use gaitclip_lsm6dsv320x::{HighGOdr, Odr};
 
-    let bytes: &'static [u8] = std::fs::read(
-        std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../fixtures/sprint_40g.lsm6dsv320x"),
-    )
-    .unwrap()
-    .leak();
-    let recorded = Recorded {
-        odr_field: Odr::Hz240.field(),
-        fs_xl: LSM_ACCEL.field(),
-        fs_g: LSM_GYRO.field(),
-        high_g_ctrl: LSM_HIGH_G.field() | (HighGOdr::Hz960.field() << 3),
-        words_per_period: LSM_WORDS_PER_SAMPLE,
-    };
+    let (bytes, recorded) = sprint_fifo();
     let bus = FlakyLsm {
         inner: ReplayLsm6dsv320x::new(0x6A, bytes, recorded),
         fail,
@@ -235,10 +230,7 @@ fn the_live_sampler_reads_the_lsm6dsv320x_at_its_watermark_and_merges_as_the_rep
     use gaitclip_lsm6dsv320x::fifo::{FifoWord, WORD_BYTES};
     use gaitclip_lsm6dsv320x::merge::Assembler;
 
-    let bytes = std::fs::read(
-        std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../fixtures/sprint_40g.lsm6dsv320x"),
-    )
-    .unwrap();
+    let (bytes, _) = sprint_fifo();
     // What the QEMU replay firmware and the host replay assemble from the same words.
     let mut assembler = Assembler::new(settings::DUAL);
     let expected: Vec<_> = bytes
@@ -290,24 +282,11 @@ fn the_live_sampler_reads_the_lsm6dsv320x_at_its_watermark_and_merges_as_the_rep
 fn the_live_sampler_sends_the_lsm6dsv320x_to_its_wait_for_motion_and_back() {
     use gaitclip_board::imu_sampler::{ImuSampler, Item};
     use gaitclip_board::live_settings::lsm6dsv320x as settings;
-    use gaitclip_board::replay_lsm6dsv320x::{Recorded, ReplayLsm6dsv320x};
+    use gaitclip_board::replay_lsm6dsv320x::ReplayLsm6dsv320x;
     use gaitclip_board::sleep::SleepPolicy;
-    use gaitclip_host::sim::sprint::{LSM_ACCEL, LSM_GYRO, LSM_HIGH_G, LSM_WORDS_PER_SAMPLE};
     use gaitclip_lsm6dsv320x::blocking::{Lsm6dsv320x, Lsm6dsv320xSource};
-    use gaitclip_lsm6dsv320x::{HighGOdr, Odr};
 
-    let bytes: &'static [u8] = std::fs::read(
-        std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../fixtures/sprint_40g.lsm6dsv320x"),
-    )
-    .unwrap()
-    .leak();
-    let recorded = Recorded {
-        odr_field: Odr::Hz240.field(),
-        fs_xl: LSM_ACCEL.field(),
-        fs_g: LSM_GYRO.field(),
-        high_g_ctrl: LSM_HIGH_G.field() | (HighGOdr::Hz960.field() << 3),
-        words_per_period: LSM_WORDS_PER_SAMPLE,
-    };
+    let (bytes, recorded) = sprint_fifo();
     let part = ReplayLsm6dsv320x::new(0x6A, bytes, recorded);
     let source =
         Lsm6dsv320xSource::new(Lsm6dsv320x::new(part, settings::ADDRESS), settings::SENSOR);
@@ -317,8 +296,8 @@ fn the_live_sampler_sends_the_lsm6dsv320x_to_its_wait_for_motion_and_back() {
     let watermark = settings::SENSOR.watermark_words as usize;
     let mut items = Vec::new();
     let run = |s: &mut ImuSampler<Lsm6dsv320xSource<ReplayLsm6dsv320x>, NoopDelay>,
-                   periods: usize,
-                   items: &mut Vec<Item>| {
+               periods: usize,
+               items: &mut Vec<Item>| {
         for _ in 0..periods {
             let part = s.bus_mut().unwrap();
             part.tick();

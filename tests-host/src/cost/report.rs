@@ -193,7 +193,8 @@ pub const BUILDS: [Build; 11] = [
         machine: None,
         detector: Detector::Cycle,
         sensor: None,
-    },    Build {
+    },
+    Build {
         label: "mps2-an386 (QEMU, M4F), LSM6DSV320X sprint replay",
         dir: "boards/mps2-an386",
         bin: "mps2-an386",
