@@ -88,7 +88,7 @@ pub mod driver {
             self.into_mode()
         }
 
-        fn into_mode<N: Mode>(self) -> Lsm6dsv320x<I, N> {
+        pub(crate) fn into_mode<N: Mode>(self) -> Lsm6dsv320x<I, N> {
             Lsm6dsv320x {
                 bus: self.bus,
                 mode: PhantomData,

@@ -96,7 +96,7 @@ pub mod driver {
             self.into_mode()
         }
 
-        fn into_mode<N: Mode>(self) -> Mpu6050<I, N> {
+        pub(crate) fn into_mode<N: Mode>(self) -> Mpu6050<I, N> {
             Mpu6050 {
                 bus: self.bus,
                 mode: PhantomData,

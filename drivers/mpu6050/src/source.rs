@@ -24,6 +24,14 @@ pub mod handle {
     use crate::mode::{MotionWake, Sampling, Unconfigured};
     use crate::{Config, Error, MotionWakeConfig};
 
+    /// Which mode a driver was in before a reset.
+    #[derive(Clone, Copy)]
+    enum ModeWas {
+        Unconfigured,
+        Sampling,
+        Waiting,
+    }
+
     /// The typestate driver in whichever mode it is in.
     enum Moded<I> {
         Unconfigured(Mpu6050<I, Unconfigured>),
@@ -80,20 +88,24 @@ pub mod handle {
             mode: ReadMode,
         ) -> Result<(), Self::Error> {
             let config = self.config;
-            let (imu, result) = match self.imu.take() {
-                Some(Moded::Unconfigured(d)) => match d.init(delay, &config).await {
-                    Ok(d) => (Moded::Sampling(d), Ok(())),
-                    Err(e) => (Moded::Unconfigured(e.dev), Err(e.error)),
-                },
-                Some(Moded::Sampling(d)) => match d.init(delay, &config).await {
-                    Ok(d) => (Moded::Sampling(d), Ok(())),
-                    Err(e) => (Moded::Sampling(e.dev), Err(e.error)),
-                },
-                Some(Moded::Waiting(d)) => match d.init(delay, &config).await {
-                    Ok(d) => (Moded::Sampling(d), Ok(())),
-                    Err(e) => (Moded::Waiting(e.dev), Err(e.error)),
-                },
+            // One `init` (one copy of its work in flash) from whatever mode the part is in;
+            // on failure the driver goes back to that mode, as `init` itself hands it back.
+            let (unconfigured, was) = match self.imu.take() {
+                Some(Moded::Unconfigured(d)) => (d, ModeWas::Unconfigured),
+                Some(Moded::Sampling(d)) => (d.into_unconfigured(), ModeWas::Sampling),
+                Some(Moded::Waiting(d)) => (d.into_unconfigured(), ModeWas::Waiting),
                 None => return Err(Error::Mode),
+            };
+            let (imu, result) = match unconfigured.init(delay, &config).await {
+                Ok(d) => (Moded::Sampling(d), Ok(())),
+                Err(e) => (
+                    match was {
+                        ModeWas::Unconfigured => Moded::Unconfigured(e.dev),
+                        ModeWas::Sampling => Moded::Sampling(e.dev.into_mode()),
+                        ModeWas::Waiting => Moded::Waiting(e.dev.into_mode()),
+                    },
+                    Err(e.error),
+                ),
             };
             self.imu = Some(imu);
             result?;
