@@ -363,13 +363,8 @@ fn replay_path<'py>(
         units,
         front: Front::Python,
     };
-    if recording::is_mcap(&path) {
-        let mut trace = py.detach(|| read(&path, &how))?;
-        trace.given.acc_g = acc_range_g.or(trace.given.acc_g);
-        trace.given.gyro_dps = gyro_range_dps.or(trace.given.gyro_dps);
-        return run(py, trace, o, |row| row as u64);
-    }
-    // A CSV file is replayed as a stream, in constant memory (`gaitclip_host::stream`).
+    // A file (CSV or MCAP) is replayed as a stream, in constant memory
+    // (`gaitclip_host::stream`).
     let (strides, summary, clock) = py.detach(|| -> PyResult<_> {
         let mut s = Streamed::open(&path, &how).map_err(read_error)?;
         s.given.acc_g = acc_range_g.or(s.given.acc_g);
@@ -395,10 +390,6 @@ fn not_found(path: &Path, source: &std::io::Error) -> PyErr {
         }
         _ => PyValueError::new_err(format!("{}: {source}", path.display())),
     }
-}
-
-fn read(path: &Path, o: &recording::ReadOptions) -> PyResult<Trace> {
-    recording::read(path, o).map_err(read_error)
 }
 
 /// A reading error as Python's: a file not found as `FileNotFoundError`.

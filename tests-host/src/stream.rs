@@ -1,8 +1,11 @@
-//! A CSV recording replayed in constant memory: a week at 100 Hz is 60 M samples, and
-//! holding it (≈ 160 bytes a sample in the replay that reads it whole) would take 10 GB.
+//! A recording (CSV or MCAP) replayed in constant memory: a week at 100 Hz is 60 M samples,
+//! and holding it (≈ 160 bytes a sample in the replay that reads it whole) would take 10 GB.
 //!
 //! **How.** The file is parsed once, row by row, into a spool on disk (64 bytes a row: the
-//! stamp, the six values, the line for the errors; deleted when the replay ends). Every step
+//! stamp, the six values, the line (CSV) or message index (MCAP) for the errors; deleted
+//! when the replay ends). An MCAP file is read twice for that, one record at a time
+//! ([`crate::io::mcap_io::visit_records`]: its chunks' record lengths checked, then its
+//! records decoded), as the reader that reads it whole does. Every step
 //! that looks at the whole recording then reads the spool again from the start, in order,
 //! keeping only what it needs, and the last pass feeds the core and hands each stride out
 //! as the pipeline reports it. What each step keeps:
@@ -19,13 +22,14 @@
 //!
 //! Every step runs the code the whole-recording replay runs ([`crate::replay`], the same
 //! functions over a slice), with the same arithmetic in the same order: the output is
-//! byte-identical (a test replays every shared CSV recording both ways, and recordings with
-//! every fault the readers handle or refuse). What grows with the recording is what it
+//! byte-identical (a test replays every shared CSV recording both ways, a sample of them
+//! written as MCAP, the MCAP conformance files, and recordings with every fault the readers
+//! handle or refuse). What grows with the recording is what it
 //! holds: its holes (16 bytes each; `ipol_gait_events`' lossy link loses 2 % of its packets in
 //! holes of 1–11) and the movements the step check refuses (a few per minute of not
 //! walking). A week at 100 Hz of walks (60 M samples) peaks at about 10 MiB
-//! (`tests-host/cost.sh`, docs/cost.md). An MCAP recording, or a replay that writes the
-//! samples back out (`--mcap-out`), is still read whole.
+//! (`tests-host/cost.sh`, docs/cost.md). A replay that writes the samples back out
+//! (`--mcap-out`) still reads the recording whole.
 
 use std::cell::RefCell;
 use std::fs::File;
@@ -40,10 +44,11 @@ use gaitclip::sensor::rate::SampleRate;
 
 use crate::io::clock::{nominal_period_of, RepeatFilter, SampleClock};
 use crate::io::csv_trace::{self, CsvError};
+use crate::io::mcap_io::{self, ImuMessages, McapError};
 use crate::io::rails::{self, RailsReport};
-use crate::io::recording::{ReadError, ReadOptions, RATE_DISAGREES};
+use crate::io::recording::{self, ReadError, ReadOptions, RATE_DISAGREES};
 use crate::io::trace::{GivenRanges, ImuSample, Ranges};
-use crate::io::units::{self, Front};
+use crate::io::units::{self, Front, Units};
 use crate::replay::{self, Preparation, ReplayError, StrideReport, StrideTally, Summary};
 
 /// Bytes of a row in the spool: the stamp, six values and the line, eight bytes each.
@@ -66,6 +71,8 @@ pub struct Spool {
     rows: usize,
     t_col: usize,
     source: PathBuf,
+    /// The recording is MCAP (its errors are MCAP's).
+    mcap: bool,
     /// A read of the spool that failed (the disk, not the recording): said at the end.
     failed: RefCell<Option<std::io::Error>>,
 }
@@ -75,15 +82,61 @@ pub struct Spool {
 pub struct SpooledRow {
     /// The sample as read (the file's units).
     pub sample: ImuSample,
-    /// Its 1-based line in the file.
+    /// Its 1-based line in a CSV file; its 0-based index among an MCAP file's IMU
+    /// messages.
     pub line: u64,
 }
 
 impl Spool {
+    /// An empty spool for the recording `path`, its file created in the temporary folder
+    /// ([`std::env::temp_dir`]), and a writer to it.
+    fn create(
+        path: &Path,
+        mcap: bool,
+    ) -> Result<(Spool, BufWriter<File>), (PathBuf, std::io::Error)> {
+        static NEXT: AtomicU64 = AtomicU64::new(0);
+        let file = std::env::temp_dir().join(format!(
+            "gaitclip-{}-{}.spool",
+            std::process::id(),
+            NEXT.fetch_add(1, Ordering::Relaxed)
+        ));
+        let out = match File::create(&file) {
+            Ok(f) => BufWriter::with_capacity(1 << 20, f),
+            Err(e) => return Err((file, e)),
+        };
+        let spool = Spool {
+            file,
+            rows: 0,
+            t_col: 1,
+            source: path.to_owned(),
+            mcap,
+            failed: RefCell::new(None),
+        };
+        Ok((spool, out))
+    }
+
+    /// One row to `out`: the sample and its line (or index).
+    fn write_row(out: &mut impl Write, s: &ImuSample, line: u64) -> std::io::Result<()> {
+        let mut b = [0u8; ROW_BYTES];
+        let v = [
+            s.t_s,
+            s.acc_mps2[0],
+            s.acc_mps2[1],
+            s.acc_mps2[2],
+            s.gyr_radps[0],
+            s.gyr_radps[1],
+            s.gyr_radps[2],
+        ];
+        for (k, x) in v.iter().enumerate() {
+            b[8 * k..8 * k + 8].copy_from_slice(&x.to_le_bytes());
+        }
+        b[56..].copy_from_slice(&line.to_le_bytes());
+        out.write_all(&b)
+    }
+
     /// Parses the CSV file `path` into a spool in the temporary folder
     /// ([`std::env::temp_dir`]), with the errors [`csv_trace::read`] gives.
     pub fn of_csv(path: &Path) -> Result<Spool, CsvError> {
-        static NEXT: AtomicU64 = AtomicU64::new(0);
         let io = |source| CsvError::Io {
             path: path.to_owned(),
             source,
@@ -91,48 +144,77 @@ impl Spool {
         // A first read says what reading the whole file would (a folder: "Is a directory").
         let mut input = BufReader::with_capacity(1 << 20, File::open(path).map_err(io)?);
         std::io::BufRead::fill_buf(&mut input).map_err(io)?;
-        let file = std::env::temp_dir().join(format!(
-            "gaitclip-{}-{}.spool",
-            std::process::id(),
-            NEXT.fetch_add(1, Ordering::Relaxed)
-        ));
-        let mut spool = Spool {
-            file: file.clone(),
-            rows: 0,
-            t_col: 1,
-            source: path.to_owned(),
-            failed: RefCell::new(None),
-        };
+        let (mut spool, mut out) =
+            Spool::create(path, false).map_err(|(path, source)| CsvError::Io { path, source })?;
+        let file = spool.file.clone();
         let spool_io = |source| CsvError::Io {
             path: file.clone(),
             source,
         };
-        let mut out = BufWriter::with_capacity(1 << 20, File::create(&file).map_err(spool_io)?);
         let mut rows = 0usize;
         spool.t_col = csv_trace::parse_each(path, input, |s, line| {
-            let mut b = [0u8; ROW_BYTES];
-            let v = [
-                s.t_s,
-                s.acc_mps2[0],
-                s.acc_mps2[1],
-                s.acc_mps2[2],
-                s.gyr_radps[0],
-                s.gyr_radps[1],
-                s.gyr_radps[2],
-            ];
-            for (k, x) in v.iter().enumerate() {
-                b[8 * k..8 * k + 8].copy_from_slice(&x.to_le_bytes());
-            }
-            b[56..].copy_from_slice(&line.to_le_bytes());
             rows += 1;
-            out.write_all(&b).map_err(|source| CsvError::Io {
-                path: file.clone(),
-                source,
-            })
+            Spool::write_row(&mut out, &s, line).map_err(spool_io)
         })?;
         out.flush().map_err(spool_io)?;
         spool.rows = rows;
         Ok(spool)
+    }
+
+    /// Decodes the MCAP file `path` into a spool (its IMU channel's messages, in file
+    /// order) with the errors [`mcap_io::decode`] gives before it drops re-sent samples,
+    /// reading the file twice and holding one record at a time; the IMU channel's topic.
+    pub fn of_mcap(path: &Path) -> Result<(Spool, String), McapError> {
+        let io = |source| McapError::Io {
+            path: path.to_owned(),
+            source,
+        };
+        // A first read says what reading the whole file would (a folder: "Is a directory").
+        let mut first = BufReader::new(File::open(path).map_err(io)?);
+        std::io::BufRead::fill_buf(&mut first).map_err(io)?;
+        let len = first.get_ref().metadata().map_err(io)?.len();
+        drop(first);
+        let (mut spool, mut out) =
+            Spool::create(path, true).map_err(|(path, source)| McapError::Io { path, source })?;
+        let file = spool.file.clone();
+        let spool_io = |source| McapError::Io {
+            path: file.clone(),
+            source,
+        };
+        let mut imu = ImuMessages::new(path);
+        let mut rows = 0usize;
+        // The whole-file reader reads every record before it decodes a message, so an error
+        // in a record later in the file wins over a message that does not decode: the first
+        // such message's error is kept until the walk ends.
+        let mut bad_message = None;
+        let open = || {
+            File::open(path)
+                .map(|f| BufReader::with_capacity(1 << 20, f))
+                .map_err(io)
+        };
+        mcap_io::visit_records(path, &open, len, |r| {
+            if bad_message.is_some() {
+                return Ok(());
+            }
+            match imu.take(r, rows) {
+                Ok(Some(s)) => {
+                    Spool::write_row(&mut out, &s, rows as u64).map_err(spool_io)?;
+                    rows += 1;
+                }
+                Ok(None) => {}
+                Err(e) => bad_message = Some(e),
+            }
+            Ok(())
+        })?;
+        if let Some(e) = bad_message {
+            return Err(e);
+        }
+        if rows == 0 {
+            return Err(imu.no_imu_channel());
+        }
+        out.flush().map_err(spool_io)?;
+        spool.rows = rows;
+        Ok((spool, imu.topic().to_owned()))
     }
 
     /// Rows in the spool.
@@ -157,11 +239,15 @@ impl Spool {
     }
 
     /// The error a read of the spool met, if one did (as an error of the recording's file).
-    fn failure(&self) -> Option<CsvError> {
-        self.failed.borrow_mut().take().map(|source| CsvError::Io {
-            path: self.source.clone(),
-            source,
-        })
+    fn failure(&self) -> Option<ReadError> {
+        let path = self.source.clone();
+        self.failed
+            .borrow_mut()
+            .take()
+            .map(|source| match self.mcap {
+                true => McapError::Io { path, source }.into(),
+                false => CsvError::Io { path, source }.into(),
+            })
     }
 }
 
@@ -224,18 +310,28 @@ pub struct Streamed {
 }
 
 impl Streamed {
-    /// Reads the CSV file `path` as `o` says, with [`crate::io::recording::read`]'s checks
-    /// and errors. Not for MCAP.
+    /// Reads the recording `path` (CSV, or MCAP told by [`recording::is_mcap`]) as `o` says,
+    /// with [`crate::io::recording::read`]'s checks and errors.
     pub fn open(path: &Path, o: &ReadOptions) -> Result<Streamed, ReadError> {
-        let rate_given = match o.rate_hz {
-            Some(r) => Some(r),
-            None => csv_trace::meta_rate(path)?,
+        let mcap = recording::is_mcap(path);
+        // An MCAP file has no `meta.json`: its rate is the one given or the stamps', its
+        // values m/s² and rad/s unless declared otherwise.
+        let rate_given = match (o.rate_hz, mcap) {
+            (Some(r), _) => Some(r),
+            (None, true) => None,
+            (None, false) => csv_trace::meta_rate(path)?,
         };
-        let declared = match o.units {
-            Some(u) => u,
-            None => csv_trace::meta_units(path)?,
+        let declared = match (o.units, mcap) {
+            (Some(u), _) => u,
+            (None, true) => Units::default(),
+            (None, false) => csv_trace::meta_units(path)?,
         };
-        let spool = Spool::of_csv(path)?;
+        let (spool, topic) = if mcap {
+            let (spool, topic) = Spool::of_mcap(path)?;
+            (spool, Some(topic))
+        } else {
+            (Spool::of_csv(path)?, None)
+        };
         // Re-sent samples: at the rate known, else at the stamps' (as `Trace::drop_repeats`).
         let raw_stamps = || spool.read().map(|r| r.sample.t_s);
         let repeat_period_s = match rate_given {
@@ -249,14 +345,20 @@ impl Streamed {
                 Ok(true) => kept += 1,
                 Ok(false) => {}
                 Err(e) => {
-                    return Err(CsvError::TimeGoesBack {
-                        path: path.to_owned(),
-                        line: r.line,
-                        col: spool.t_col,
-                        t_s: e.t_s,
-                        previous_s: e.previous_s,
-                    }
-                    .into())
+                    return Err(match &topic {
+                        Some(topic) => {
+                            mcap_io::time_goes_back(path, topic, e.index, e.t_s, e.previous_s)
+                                .into()
+                        }
+                        None => CsvError::TimeGoesBack {
+                            path: path.to_owned(),
+                            line: r.line,
+                            col: spool.t_col,
+                            t_s: e.t_s,
+                            previous_s: e.previous_s,
+                        }
+                        .into(),
+                    })
                 }
             }
         }
@@ -270,24 +372,34 @@ impl Streamed {
             given: GivenRanges::default(),
         };
         if let Some(e) = s.spool.failure() {
-            return Err(e.into());
+            return Err(e);
         }
-        units::check_of(&|| s.samples(), s.kept, declared, o.front).map_err(|unit| {
-            CsvError::Units {
+        units::check_of(&|| s.samples(), s.kept, declared, o.front).map_err(|unit| match mcap {
+            true => ReadError::from(McapError::Units {
+                path: path.to_owned(),
+                unit,
+            }),
+            false => CsvError::Units {
                 path: path.to_owned(),
                 unit,
             }
+            .into(),
         })?;
         let stamps_hz = |s: &Streamed| {
             nominal_period_of(&|| s.samples().map(|x| x.t_s), s.kept).map(|p| 1.0 / p)
         };
-        s.rate_hz = match rate_given {
-            Some(r) => r,
-            None => stamps_hz(&s).ok_or_else(|| CsvError::Empty {
+        s.rate_hz = match (rate_given, mcap) {
+            (Some(r), _) => r,
+            // As `mcap_io::decode`: no rate the stamps can give is 0 Hz, which the replay
+            // refuses.
+            (None, true) => stamps_hz(&s).unwrap_or(0.0),
+            (None, false) => stamps_hz(&s).ok_or_else(|| CsvError::Empty {
                 path: path.to_owned(),
             })?,
         };
-        s.given = csv_trace::meta_ranges(path)?;
+        if !mcap {
+            s.given = csv_trace::meta_ranges(path)?;
+        }
         if let (Some(given_hz), false) = (o.rate_hz, o.rate_overrides_stamps) {
             if let Some(stamps_hz) =
                 stamps_hz(&s).filter(|h| (given_hz / h - 1.0).abs() > RATE_DISAGREES)
@@ -304,7 +416,7 @@ impl Streamed {
             }
         }
         if let Some(e) = s.spool.failure() {
-            return Err(e.into());
+            return Err(e);
         }
         Ok(s)
     }
@@ -378,7 +490,7 @@ impl Streamed {
             stride(r);
         });
         if let Some(e) = self.spool.failure() {
-            return Err(ReadError::from(e).into());
+            return Err(e.into());
         }
         let summary = Preparation {
             read: (self.kept + self.repeated, self.repeated),

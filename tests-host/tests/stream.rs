@@ -9,8 +9,9 @@ use gaitclip::length::models::Model;
 use gaitclip::pipeline::config::DEFAULT_MODEL;
 use gaitclip::pipeline::detectors::Detector;
 use gaitclip_host::io::datasets::root_or_skip;
+use gaitclip_host::io::mcap_io;
 use gaitclip_host::io::recording::{self, ReadOptions};
-use gaitclip_host::io::trace::Ranges;
+use gaitclip_host::io::trace::{ImuSample, Ranges};
 use gaitclip_host::io::units::{AccUnit, Front, GyroUnit, Units};
 use gaitclip_host::replay;
 use gaitclip_host::stream::{StreamError, Streamed};
@@ -55,6 +56,104 @@ fn scratch(name: &str) -> PathBuf {
     let _ = std::fs::remove_dir_all(&d);
     std::fs::create_dir_all(&d).unwrap();
     d
+}
+
+/// A CSV file's rows as they stand (stamp and six values, no checks), or `None` if it has
+/// none or is not there.
+fn raw_rows(path: &Path) -> Option<Vec<ImuSample>> {
+    let text = std::fs::read_to_string(path).ok()?;
+    let rows: Vec<ImuSample> = text
+        .lines()
+        .skip(1)
+        .filter_map(|l| {
+            let v: Vec<f64> = l
+                .split(',')
+                .map(|c| c.trim().parse().ok())
+                .collect::<Option<_>>()?;
+            (v.len() >= 7).then(|| ImuSample {
+                t_s: v[0],
+                acc_mps2: [v[1], v[2], v[3]],
+                gyr_radps: [v[4], v[5], v[6]],
+            })
+        })
+        .collect();
+    (!rows.is_empty()).then_some(rows)
+}
+
+/// `rows` as an MCAP file of gaitclip's IMU messages at `path`.
+fn write_mcap(path: &Path, rows: &[ImuSample]) {
+    let f = std::io::BufWriter::new(std::fs::File::create(path).unwrap());
+    mcap_io::write(f, rows, &[], None).unwrap();
+}
+
+#[test]
+fn shared_recordings_written_as_mcap_stream_to_the_same_bytes() {
+    let Some(root) = root_or_skip("shared_recordings_written_as_mcap_stream_to_the_same_bytes")
+    else {
+        return;
+    };
+    // Every dataset's first recordings, each up to 200 000 samples (the courses' 800 Hz
+    // recordings run to millions: as MCAP, JSON messages of 150 bytes each).
+    let d = scratch("stream-mcap");
+    let mut written = 0;
+    let mut datasets: Vec<PathBuf> = std::fs::read_dir(&root)
+        .unwrap()
+        .map(|e| e.unwrap().path())
+        .filter(|p| p.is_dir())
+        .collect();
+    datasets.sort();
+    for dataset in &datasets {
+        let mut csvs: Vec<PathBuf> = Vec::new();
+        let mut stack = vec![dataset.clone()];
+        while let Some(dir) = stack.pop() {
+            for e in std::fs::read_dir(&dir).unwrap() {
+                let p = e.unwrap().path();
+                let name = p.file_name().unwrap().to_string_lossy().to_string();
+                if p.is_dir() {
+                    stack.push(p);
+                } else if name.ends_with(".csv")
+                    && !name.ends_with(".reference.csv")
+                    && !["strides.csv", "events.csv", "trials.csv", "labels.csv"]
+                        .contains(&name.as_str())
+                {
+                    csvs.push(p);
+                }
+            }
+        }
+        csvs.sort();
+        let mut here = 0;
+        for p in &csvs {
+            if here == 3 {
+                break;
+            }
+            // The recording as the whole reader reads it (its units, `meta.json`'s rate),
+            // written as MCAP in SI units with that rate given.
+            let Ok(t) = recording::read(p, &ReadOptions::default()) else {
+                continue;
+            };
+            if t.samples.len() > 200_000 {
+                continue;
+            }
+            let m = d.join(format!("{written}.mcap"));
+            write_mcap(&m, &t.samples);
+            let o = ReadOptions {
+                rate_hz: Some(t.rate_hz),
+                ..ReadOptions::default()
+            };
+            let [whole, streamed] = both(&m, &o, Detector::Cycle, DEFAULT_MODEL);
+            assert!(!whole.starts_with("error"), "{}: {whole}", p.display());
+            assert!(
+                whole == streamed,
+                "{} as MCAP: streamed differs",
+                p.display()
+            );
+            here += 1;
+            written += 1;
+        }
+    }
+    assert!(written >= 12, "{written} recordings written as MCAP");
+    eprintln!("{written} recordings written as MCAP streamed to the same bytes");
+    let _ = std::fs::remove_dir_all(d);
 }
 
 #[test]
@@ -187,6 +286,62 @@ fn faults_stream_to_the_same_bytes_and_errors() {
     cases.push((write("bad.csv", &bad), plain));
     cases.push((write("empty.csv", &[]), plain));
     cases.push((d.join("missing.csv"), plain));
+    // The same as MCAP (gaitclip's JSON IMU messages, stamps and values as the rows hold
+    // them), with the same options; and what only MCAP can get wrong.
+    let mut mcap_cases: Vec<(PathBuf, ReadOptions)> = Vec::new();
+    for (p, o) in &cases {
+        if let Some(rows) = raw_rows(p) {
+            let m = p.with_extension("mcap");
+            write_mcap(&m, &rows);
+            mcap_cases.push((m, *o));
+        }
+    }
+    let mut non_finite = raw_rows(&d.join("plain.csv")).unwrap();
+    non_finite[77].gyr_radps[1] = f64::NAN;
+    let nan = d.join("nan.mcap");
+    write_mcap(&nan, &non_finite);
+    mcap_cases.push((nan, plain));
+    let good = std::fs::read(d.join("plain.mcap")).unwrap();
+    for (name, bytes) in [
+        // Cut in the middle of a message (no summary, no footer).
+        ("cut.mcap", good[..good.len() / 2].to_vec()),
+        // A git-LFS pointer where the recording should be.
+        (
+            "pointer.mcap",
+            b"version https://git-lfs.github.com/spec/v1\noid sha256:abc\nsize 1234\n".to_vec(),
+        ),
+        // The magic alone.
+        ("magic.mcap", good[..8].to_vec()),
+    ] {
+        let m = d.join(name);
+        std::fs::write(&m, bytes).unwrap();
+        mcap_cases.push((m, plain));
+    }
+    let mut data_dir = d.join("folder.mcap");
+    std::fs::create_dir_all(&data_dir).unwrap();
+    mcap_cases.push((data_dir.clone(), plain));
+    data_dir.push("missing.mcap");
+    mcap_cases.push((data_dir, plain));
+    // The MCAP conformance files (none carries IMU messages: each one's error, both ways).
+    let conformance =
+        PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../shared/mcap-conformance");
+    let mut stack = vec![conformance];
+    while let Some(dir) = stack.pop() {
+        let Ok(entries) = std::fs::read_dir(&dir) else {
+            continue;
+        };
+        for e in entries {
+            let p = e.unwrap().path();
+            if p.is_dir() {
+                stack.push(p);
+            } else if p.extension().is_some_and(|x| x == "mcap") {
+                mcap_cases.push((p, plain));
+            }
+        }
+    }
+    mcap_cases.sort_by(|a, b| a.0.cmp(&b.0));
+    eprintln!("{} MCAP cases", mcap_cases.len());
+    cases.extend(mcap_cases);
     for (p, o) in &cases {
         for (det, model) in [
             (Detector::Cycle, DEFAULT_MODEL),

@@ -547,9 +547,9 @@ fn run(cli: Cli) -> anyhow::Result<()> {
                 )
                 .into());
             }
-            // A CSV recording is replayed as a stream, in constant memory
-            // (`gaitclip_host::stream`); an MCAP one, or one written back out, whole.
-            let streamed = !recording::is_mcap(&trace) && mcap_out.is_none();
+            // A recording is replayed as a stream, in constant memory
+            // (`gaitclip_host::stream`); one written back out (`--mcap-out`), whole.
+            let streamed = mcap_out.is_none();
             let (mut t, stream) = if streamed {
                 let o = recording::ReadOptions {
                     rate_hz: rate,

@@ -3,7 +3,7 @@
 
 use std::collections::BTreeMap;
 use std::fs;
-use std::io::{Seek, Write};
+use std::io::{Read, Seek, Write};
 use std::path::{Path, PathBuf};
 
 use serde::{Deserialize, Serialize};
@@ -113,7 +113,7 @@ pub enum McapError {
     Write(mcap::McapError),
 }
 
-#[derive(Clone, Copy, PartialEq)]
+#[derive(Clone, Copy, Debug, PartialEq)]
 enum ImuKind {
     Json,
     Ros2Cdr,
@@ -177,9 +177,43 @@ pub enum McapRecord {
 /// Reads every schema, channel and message record of an MCAP file's bytes, in file order;
 /// `path` is only for error messages.
 pub fn read_records(path: &Path, bytes: &[u8]) -> Result<Vec<McapRecord>, McapError> {
-    const LFS: &[u8] = b"version https://git-lfs.github.com/spec/v1\n";
-    if let Some(rest) = bytes.strip_prefix(LFS) {
-        let text = String::from_utf8_lossy(rest);
+    let mut out = Vec::new();
+    visit_records(path, &|| Ok(bytes), bytes.len() as u64, |r| {
+        out.push(r);
+        Ok(())
+    })?;
+    Ok(out)
+}
+
+/// The git-LFS pointer's first line: a file that starts with it was never fetched.
+const LFS: &[u8] = b"version https://git-lfs.github.com/spec/v1\n";
+
+/// Every schema, channel and message record of an MCAP file to `each`, in file order,
+/// without holding the file: `open` gives its bytes from the start (read twice: once to
+/// check the chunks' record lengths, once to read the records), `len` is their length.
+/// `each`'s error stops the walk and is returned. The same checks and errors as
+/// [`read_records`], which is this on bytes in memory.
+pub fn visit_records<'a, R: Read + 'a>(
+    path: &Path,
+    open: &dyn Fn() -> Result<R, McapError>,
+    len: u64,
+    mut each: impl FnMut(McapRecord) -> Result<(), McapError>,
+) -> Result<(), McapError> {
+    let io = |source| McapError::Io {
+        path: path.to_owned(),
+        source,
+    };
+    let mut input = open()?;
+    let mut head = Vec::with_capacity(LFS.len());
+    (&mut input)
+        .take(LFS.len() as u64)
+        .read_to_end(&mut head)
+        .map_err(io)?;
+    if head == LFS {
+        // A pointer is a few lines of text; read no more than a page of it.
+        let mut rest = Vec::new();
+        input.take(4096).read_to_end(&mut rest).map_err(io)?;
+        let text = String::from_utf8_lossy(&rest);
         let field = |k: &str| {
             text.lines()
                 .find_map(|l| l.strip_prefix(k))
@@ -193,26 +227,25 @@ pub fn read_records(path: &Path, bytes: &[u8]) -> Result<Vec<McapRecord>, McapEr
             size: field("size "),
         });
     }
+    drop(input);
+    check_uncompressed_chunks(path, open()?, len)?;
     let fmt = |source| McapError::Format {
         path: path.to_owned(),
         source,
     };
-    check_uncompressed_chunks(path, bytes)?;
-    let mut out = Vec::new();
-    // The `mcap` crate's sans-io reader, fed from the slice, with a bound on record sizes: a
-    // chunk header may claim any uncompressed size, and the reader allocates what it claims
-    // (found by fuzzing: 2⁵⁶ bytes aborts the process).
+    // The `mcap` crate's sans-io reader, fed from the file in pieces of at most a MiB, with a
+    // bound on record sizes: a chunk header may claim any uncompressed size, and the reader
+    // allocates what it claims (found by fuzzing: 2⁵⁶ bytes aborts the process).
     let mut reader = mcap::sans_io::LinearReader::new_with_options(
         mcap::sans_io::LinearReaderOptions::default().with_record_length_limit(MAX_RECORD_BYTES),
     );
-    let mut rest = bytes;
+    let mut input = open()?;
     while let Some(event) = reader.next_event() {
         let (opcode, data) = match event.map_err(fmt)? {
             mcap::sans_io::LinearReadEvent::ReadRequest(need) => {
-                let n = need.min(rest.len());
-                reader.insert(n).copy_from_slice(&rest[..n]);
+                let buf = reader.insert(need.min(1 << 20));
+                let n = read_some(&mut input, buf).map_err(io)?;
                 reader.notify_read(n);
-                rest = &rest[n..];
                 continue;
             }
             mcap::sans_io::LinearReadEvent::Record { data, opcode } => (opcode, data),
@@ -226,40 +259,55 @@ pub fn read_records(path: &Path, bytes: &[u8]) -> Result<Vec<McapRecord>, McapEr
             opcode,
             what: what.to_owned(),
         };
-        match opcode {
+        let record = match opcode {
             mcap::records::op::SCHEMA => {
                 let mut f = Fields(data);
-                out.push(McapRecord::Schema {
+                McapRecord::Schema {
                     id: f.u16().ok_or_else(|| bad("schema id"))?,
                     name: f.string().ok_or_else(|| bad("schema name"))?,
                     encoding: f.string().ok_or_else(|| bad("schema encoding"))?,
                     data: f.bytes().ok_or_else(|| bad("schema data"))?.to_vec(),
-                });
+                }
             }
             mcap::records::op::CHANNEL => {
                 let mut f = Fields(data);
-                out.push(McapRecord::Channel {
+                McapRecord::Channel {
                     id: f.u16().ok_or_else(|| bad("channel id"))?,
                     schema_id: f.u16().ok_or_else(|| bad("channel schema id"))?,
                     topic: f.string().ok_or_else(|| bad("channel topic"))?,
                     message_encoding: f.string().ok_or_else(|| bad("message encoding"))?,
                     metadata: f.map().ok_or_else(|| bad("channel metadata"))?,
-                });
+                }
             }
             mcap::records::op::MESSAGE => {
                 let mut f = Fields(data);
-                out.push(McapRecord::Message {
+                McapRecord::Message {
                     channel_id: f.u16().ok_or_else(|| bad("message channel id"))?,
                     sequence: f.u32().ok_or_else(|| bad("message sequence"))?,
                     log_time: f.u64().ok_or_else(|| bad("message log time"))?,
                     publish_time: f.u64().ok_or_else(|| bad("message publish time"))?,
                     data: f.0.to_vec(),
-                });
+                }
             }
-            _ => {}
+            _ => continue,
+        };
+        each(record)?;
+    }
+    Ok(())
+}
+
+/// Fills as much of `buf` as `r` gives before its end (a short read is not the end).
+fn read_some(r: &mut impl Read, buf: &mut [u8]) -> std::io::Result<usize> {
+    let mut n = 0;
+    while n < buf.len() {
+        match r.read(&mut buf[n..]) {
+            Ok(0) => break,
+            Ok(k) => n += k,
+            Err(e) if e.kind() == std::io::ErrorKind::Interrupted => {}
+            Err(e) => return Err(e),
         }
     }
-    Ok(out)
+    Ok(n)
 }
 
 /// The fields of an MCAP record, little-endian, read front to back; `None` when a field or
@@ -309,26 +357,37 @@ impl<'a> Fields<'a> {
 /// lengths: the `mcap` crate's reader subtracts a record's length from what is left of the
 /// chunk without checking it (found by fuzzing: an overflow panic in `linear_reader.rs`).
 /// Whatever else is wrong with the file is left to that reader to report.
-fn check_uncompressed_chunks(path: &Path, bytes: &[u8]) -> Result<(), McapError> {
+fn check_uncompressed_chunks(path: &Path, mut file: impl Read, len: u64) -> Result<(), McapError> {
     const CHUNK: u8 = 0x06;
+    let io = |source| McapError::Io {
+        path: path.to_owned(),
+        source,
+    };
     let bad = || McapError::BadRecord {
         path: path.to_owned(),
         opcode: CHUNK,
         what: "a record inside the chunk".to_owned(),
     };
-    let mut file = Fields(bytes.get(8..).unwrap_or(&[]));
-    while file.0.len() > 8 {
-        let (Some(op), Some(len)) = (file.take(1), file.u64()) else {
-            break;
-        };
+    // Past the magic; each record an opcode, a length and its body.
+    let mut left = len.saturating_sub(8);
+    std::io::copy(&mut (&mut file).take(8), &mut std::io::sink()).map_err(io)?;
+    while left > 8 {
+        let mut header = [0u8; 9];
+        file.read_exact(&mut header).map_err(io)?;
+        left -= 9;
+        let op = header[0];
+        let record_len = u64::from_le_bytes(header[1..].try_into().unwrap_or([0; 8]));
         // A record running past the end of the file is read as far as it goes: the reader
         // streams a chunk's records before it knows the chunk is cut short.
-        let n = usize::try_from(len).unwrap_or(usize::MAX).min(file.0.len());
-        let Some(body) = file.take(n) else { break };
-        if op[0] != CHUNK {
+        let n = record_len.min(left);
+        left -= n;
+        if op != CHUNK {
+            std::io::copy(&mut (&mut file).take(n), &mut std::io::sink()).map_err(io)?;
             continue;
         }
-        let mut chunk = Fields(body);
+        let mut body = Vec::new();
+        (&mut file).take(n).read_to_end(&mut body).map_err(io)?;
+        let mut chunk = Fields(&body);
         let header = (chunk.u64(), chunk.u64(), chunk.u64(), chunk.u32());
         let (Some(compression), Some(records_len)) = (chunk.bytes(), chunk.u64()) else {
             continue;
@@ -389,108 +448,18 @@ pub fn read_in(
 /// [`read`] on bytes already in memory; `path` is only for error messages.
 pub fn decode(path: &Path, bytes: &[u8], rate_hz: Option<f64>) -> Result<Trace, McapError> {
     let records = read_records(path, bytes)?;
-    // (schema name, encoding) by schema id; (topic, schema id, encoding) by channel id.
-    let mut schemas: BTreeMap<u16, &str> = BTreeMap::new();
-    let mut channels: BTreeMap<u16, (&str, u16, &str)> = BTreeMap::new();
-    let mut chosen: Option<(u16, ImuKind)> = None;
+    let mut imu = ImuMessages::new(path);
     let mut samples: Vec<ImuSample> = Vec::new();
-    for r in &records {
-        match r {
-            McapRecord::Schema { id, name, .. } => {
-                schemas.entry(*id).or_insert(name);
-            }
-            McapRecord::Channel {
-                id,
-                schema_id,
-                topic,
-                message_encoding,
-                ..
-            } => {
-                channels
-                    .entry(*id)
-                    .or_insert((topic, *schema_id, message_encoding));
-            }
-            McapRecord::Message {
-                channel_id,
-                log_time,
-                data,
-                ..
-            } => {
-                let Some(&(topic, schema_id, encoding)) = channels.get(channel_id) else {
-                    continue;
-                };
-                if chosen.is_none() {
-                    let schema = schemas.get(&schema_id).copied().unwrap_or("");
-                    chosen = imu_kind(schema, encoding).map(|k| (*channel_id, k));
-                }
-                let Some((id, kind)) = chosen else { continue };
-                if *channel_id != id {
-                    continue;
-                }
-                let bad = |message: String| McapError::BadMessage {
-                    path: path.to_owned(),
-                    index: samples.len(),
-                    topic: topic.to_owned(),
-                    message,
-                };
-                let s = match kind {
-                    ImuKind::Json => {
-                        let j: ImuJson =
-                            serde_json::from_slice(data).map_err(|e| bad(e.to_string()))?;
-                        ImuSample {
-                            t_s: j.t_s,
-                            acc_mps2: j.acc,
-                            gyr_radps: j.gyr,
-                        }
-                    }
-                    ImuKind::Ros2Cdr => {
-                        let mut s = decode_ros2_imu(data).map_err(bad)?;
-                        if s.t_s == 0.0 {
-                            s.t_s = *log_time as f64 * 1e-9;
-                        }
-                        s
-                    }
-                };
-                if !(s.t_s.is_finite()
-                    && s.acc_mps2.iter().chain(&s.gyr_radps).all(|v| v.is_finite()))
-                {
-                    return Err(bad("non-finite value".into()));
-                }
-                samples.push(s);
-            }
+    for r in records {
+        if let Some(s) = imu.take(r, samples.len())? {
+            samples.push(s);
         }
     }
     if samples.is_empty() {
-        let seen = if channels.is_empty() {
-            "none".to_owned()
-        } else {
-            channels
-                .values()
-                .map(|&(t, sid, e)| {
-                    let s = schemas.get(&sid).copied().unwrap_or("no schema");
-                    format!("{t} ({s}, {e})")
-                })
-                .collect::<Vec<_>>()
-                .join(", ")
-        };
-        return Err(McapError::NoImuChannel {
-            path: path.to_owned(),
-            seen,
-        });
+        return Err(imu.no_imu_channel());
     }
-    let topic = chosen
-        .and_then(|(id, _)| channels.get(&id))
-        .map_or("", |c| c.0);
-    let (samples, repeated) =
-        Trace::drop_repeats(samples, rate_hz).map_err(|e| McapError::BadMessage {
-            path: path.to_owned(),
-            index: e.index,
-            topic: topic.to_owned(),
-            message: format!(
-                "time {} s goes back from the previous message's {} s by more than half a period",
-                e.t_s, e.previous_s
-            ),
-        })?;
+    let (samples, repeated) = Trace::drop_repeats(samples, rate_hz)
+        .map_err(|e| imu.time_goes_back(e.index, e.t_s, e.previous_s))?;
     let rate_hz = rate_hz
         .or_else(|| Trace::rate_from_timestamps(&samples))
         .unwrap_or(0.0);
@@ -500,6 +469,155 @@ pub fn decode(path: &Path, bytes: &[u8], rate_hz: Option<f64>) -> Result<Trace, 
         repeated,
         given: Default::default(),
     })
+}
+
+/// The error of the IMU message `index` on `topic` of the file `path`, whose stamp `t_s`
+/// goes back from the previous one's by more than half a period
+/// ([`crate::io::clock::TimeGoesBack`]).
+pub fn time_goes_back(
+    path: &Path,
+    topic: &str,
+    index: usize,
+    t_s: f64,
+    previous_s: f64,
+) -> McapError {
+    McapError::BadMessage {
+        path: path.to_owned(),
+        index,
+        topic: topic.to_owned(),
+        message: format!(
+            "time {t_s} s goes back from the previous message's {previous_s} s by more than half a period"
+        ),
+    }
+}
+
+/// The IMU samples among an MCAP file's records, one record at a time: the schemas and
+/// channels seen so far, and the IMU channel chosen (the first to carry a message). What
+/// [`decode`] and the streamed replay (`crate::stream`) read a file with.
+pub struct ImuMessages<'p> {
+    path: &'p Path,
+    /// Schema name by schema id.
+    schemas: BTreeMap<u16, String>,
+    /// (topic, schema id, encoding) by channel id.
+    channels: BTreeMap<u16, (String, u16, String)>,
+    chosen: Option<(u16, ImuKind)>,
+}
+
+impl<'p> ImuMessages<'p> {
+    /// Nothing seen yet in the file `path` (for the errors).
+    pub fn new(path: &'p Path) -> Self {
+        ImuMessages {
+            path,
+            schemas: BTreeMap::new(),
+            channels: BTreeMap::new(),
+            chosen: None,
+        }
+    }
+
+    /// The next record: the IMU sample it carries, if it is a message on the IMU channel
+    /// (`index` the number of samples before it, for the errors).
+    pub fn take(&mut self, r: McapRecord, index: usize) -> Result<Option<ImuSample>, McapError> {
+        match r {
+            McapRecord::Schema { id, name, .. } => {
+                self.schemas.entry(id).or_insert(name);
+                Ok(None)
+            }
+            McapRecord::Channel {
+                id,
+                schema_id,
+                topic,
+                message_encoding,
+                ..
+            } => {
+                self.channels
+                    .entry(id)
+                    .or_insert((topic, schema_id, message_encoding));
+                Ok(None)
+            }
+            McapRecord::Message {
+                channel_id,
+                log_time,
+                data,
+                ..
+            } => {
+                let Some((topic, schema_id, encoding)) = self.channels.get(&channel_id) else {
+                    return Ok(None);
+                };
+                if self.chosen.is_none() {
+                    let schema = self.schemas.get(schema_id).map_or("", String::as_str);
+                    self.chosen = imu_kind(schema, encoding).map(|k| (channel_id, k));
+                }
+                let Some((id, kind)) = self.chosen else {
+                    return Ok(None);
+                };
+                if channel_id != id {
+                    return Ok(None);
+                }
+                let bad = |message: String| McapError::BadMessage {
+                    path: self.path.to_owned(),
+                    index,
+                    topic: topic.clone(),
+                    message,
+                };
+                let s = match kind {
+                    ImuKind::Json => {
+                        let j: ImuJson =
+                            serde_json::from_slice(&data).map_err(|e| bad(e.to_string()))?;
+                        ImuSample {
+                            t_s: j.t_s,
+                            acc_mps2: j.acc,
+                            gyr_radps: j.gyr,
+                        }
+                    }
+                    ImuKind::Ros2Cdr => {
+                        let mut s = decode_ros2_imu(&data).map_err(bad)?;
+                        if s.t_s == 0.0 {
+                            s.t_s = log_time as f64 * 1e-9;
+                        }
+                        s
+                    }
+                };
+                if !(s.t_s.is_finite()
+                    && s.acc_mps2.iter().chain(&s.gyr_radps).all(|v| v.is_finite()))
+                {
+                    return Err(bad("non-finite value".into()));
+                }
+                Ok(Some(s))
+            }
+        }
+    }
+
+    /// The error of a file whose records held no IMU sample: the channels it has.
+    pub fn no_imu_channel(&self) -> McapError {
+        let seen = if self.channels.is_empty() {
+            "none".to_owned()
+        } else {
+            self.channels
+                .values()
+                .map(|(t, sid, e)| {
+                    let s = self.schemas.get(sid).map_or("no schema", String::as_str);
+                    format!("{t} ({s}, {e})")
+                })
+                .collect::<Vec<_>>()
+                .join(", ")
+        };
+        McapError::NoImuChannel {
+            path: self.path.to_owned(),
+            seen,
+        }
+    }
+
+    /// [`time_goes_back`] on this file's IMU channel.
+    pub fn time_goes_back(&self, index: usize, t_s: f64, previous_s: f64) -> McapError {
+        time_goes_back(self.path, self.topic(), index, t_s, previous_s)
+    }
+
+    /// The IMU channel's topic ("" before one is chosen).
+    pub fn topic(&self) -> &str {
+        self.chosen
+            .and_then(|(id, _)| self.channels.get(&id))
+            .map_or("", |c| c.0.as_str())
+    }
 }
 
 /// Decodes a CDR-encoded ROS 2 `sensor_msgs/msg/Imu`: header stamp, frame id, orientation
