@@ -68,8 +68,22 @@ long_out=$(mktemp)
 /usr/bin/time -f "%M %e" -o "$long_out" "target/$host/release/gaitclip" replay --json "$week" \
   | tail -1 > target/cost/week-summary.json
 read -r long_kb long_s < "$long_out"
-rm -f "$week" "$long_out"
+# The same walks as MCAP: the week's first day (8.64 M samples) written by `replay
+# --mcap-out` (gaitclip's JSON IMU messages; that replay reads whole), then replayed.
+day="$root/tests-host/target/cost/day.csv"
+day_mcap="$root/tests-host/target/cost/day.mcap"
+day_samples=8640000
+head -n $((day_samples + 1)) "$week" > "$day"
+rm -f "$week"
+"target/$host/release/gaitclip" replay "$day" --mcap-out "$day_mcap" > /dev/null
+rm -f "$day"
+day_bytes=$(stat -c %s "$day_mcap")
+/usr/bin/time -f "%M %e" -o "$long_out" "target/$host/release/gaitclip" replay --json "$day_mcap" \
+  | tail -1 > target/cost/day-summary.json
+read -r day_kb day_s < "$long_out"
+rm -f "$day_mcap" "$long_out"
 long_strides=$(python3 -c 'import json,sys; print(json.load(open(sys.argv[1]))["summary"]["strides"])' target/cost/week-summary.json)
+day_strides=$(python3 -c 'import json,sys; print(json.load(open(sys.argv[1]))["summary"]["strides"])' target/cost/day-summary.json)
 
 cpu=$(sed -n 's/^model name[[:space:]]*: //p' /proc/cpuinfo | head -1)
 out=$(mktemp)
@@ -80,11 +94,13 @@ echo "$report"
 echo
 echo "### Constant memory"
 echo
-echo "\`gaitclip replay --json\` of a week at 100 Hz: $long_samples samples of \`ipol_gait_events\`' walks one after another on a clean clock, a $((week_bytes / 1000000)) MB CSV (the spool beside it, 64 bytes a sample, on disk):"
+echo "\`gaitclip replay --json\` of a week at 100 Hz: $long_samples samples of \`ipol_gait_events\`' walks one after another on a clean clock, a $((week_bytes / 1000000)) MB CSV; and of its first day written as MCAP, a $((day_bytes / 1000000)) MB file (the spool beside each, 64 bytes a sample, on disk):"
 echo
-echo "| samples | strides | peak resident memory | wall time | samples/s |"
-echo "|---:|---:|---:|---:|---:|"
-python3 -c 'import sys; n,k,kb,s=int(sys.argv[1]),sys.argv[2],int(sys.argv[3]),float(sys.argv[4]); print(f"| {n} | {k} | {kb/1024:.1f} MiB | {s:.1f} s | {n/s:,.0f} |".replace(",", " "))' "$long_samples" "$long_strides" "$long_kb" "$long_s"
+echo "| recording | samples | strides | peak resident memory | wall time | samples/s |"
+echo "|---|---:|---:|---:|---:|---:|"
+row='import sys; f,n,k,kb,s=sys.argv[1],int(sys.argv[2]),sys.argv[3],int(sys.argv[4]),float(sys.argv[5]); print(f"| {f} | {n} | {k} | {kb/1024:.1f} MiB | {s:.1f} s | {n/s:,.0f} |".replace(",", " "))'
+python3 -c "$row" "a week (CSV)" "$long_samples" "$long_strides" "$long_kb" "$long_s"
+python3 -c "$row" "a day (MCAP)" "$day_samples" "$day_strides" "$day_kb" "$day_s"
 } > "$out"
 cat "$out"
 # The tables go into docs/cost.md between its markers: re-measuring is this command, not an
