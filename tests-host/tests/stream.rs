@@ -363,5 +363,16 @@ fn faults_stream_to_the_same_bytes_and_errors() {
             );
         }
     }
+    // An un-fetched `.mcap` is named as the pointer it is, both ways.
+    let [whole, streamed] = both(
+        &d.join("pointer.mcap"),
+        &plain,
+        Detector::Cycle,
+        DEFAULT_MODEL,
+    );
+    assert!(
+        whole.contains("a git-LFS pointer") && whole == streamed,
+        "{whole}"
+    );
     let _ = std::fs::remove_dir_all(d);
 }

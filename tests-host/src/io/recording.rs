@@ -58,15 +58,19 @@ pub struct ReadOptions {
 }
 
 /// Whether `path` holds MCAP: its first bytes are [`MCAP_MAGIC`], or (a file too short or
-/// unreadable to tell) its name ends in `.mcap`. An MCAP file named `.csv` is read as MCAP.
+/// unreadable to tell, or a git-LFS pointer standing in for it) its name ends in `.mcap`.
+/// An MCAP file named `.csv` is read as MCAP; an un-fetched `.mcap` is named as a pointer by
+/// the MCAP reader instead of failing as a CSV file without its columns.
 pub fn is_mcap(path: &Path) -> bool {
     let mut head = [0u8; 8];
     let read = std::fs::File::open(path).and_then(|mut f| f.read_exact(&mut head));
+    let named_mcap = || {
+        path.extension()
+            .is_some_and(|e| e.eq_ignore_ascii_case("mcap"))
+    };
     match read {
-        Ok(()) => &head == MCAP_MAGIC,
-        Err(_) => path
-            .extension()
-            .is_some_and(|e| e.eq_ignore_ascii_case("mcap")),
+        Ok(()) => &head == MCAP_MAGIC || (&head == b"version " && named_mcap()),
+        Err(_) => named_mcap(),
     }
 }
 
