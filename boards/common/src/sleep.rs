@@ -9,8 +9,9 @@
 //! 1. the main loop asks the sampler to sleep ahead of anything still queued
 //!    ([`crate::imu_sampler::ImuSampler::request_sleep`], [`SleepPolicy::sleep_after`]),
 //!    and the sampler puts the sensor in its cycle mode with the motion interrupt latched on
-//!    INT ([`gaitclip_mpu6050::blocking::Mpu6050::enter_motion_wake`]) and queues
-//!    [`crate::imu_sampler::Item::Asleep`];
+//!    INT ([`gaitclip_mpu6050::blocking::Mpu6050::enter_motion_wake`]; the LSM6DSV320X's
+//!    low-g accelerometer alone with its wake-up on INT1, whichever part the board has:
+//!    [`crate::live_settings`]) and queues [`crate::imu_sampler::Item::Asleep`];
 //! 2. the board stops its sample-side timers (the sensor watchdog: a sleeping sensor is
 //!    silent by design), says so on its outputs, and the core waits for INT (System ON,
 //!    `wfe`/`wfi`), the radio, if any, advertising slowly;
