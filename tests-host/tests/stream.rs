@@ -58,6 +58,30 @@ fn scratch(name: &str) -> PathBuf {
     d
 }
 
+/// The recordings under `dir`, sorted: every CSV file but the datasets' truth and index
+/// tables.
+fn recordings_under(dir: &Path) -> Vec<PathBuf> {
+    let mut csvs: Vec<PathBuf> = Vec::new();
+    let mut stack = vec![dir.to_owned()];
+    while let Some(d) = stack.pop() {
+        for e in std::fs::read_dir(&d).unwrap() {
+            let p = e.unwrap().path();
+            let name = p.file_name().unwrap().to_string_lossy().to_string();
+            if p.is_dir() {
+                stack.push(p);
+            } else if name.ends_with(".csv")
+                && !name.ends_with(".reference.csv")
+                && !["strides.csv", "events.csv", "trials.csv", "labels.csv"]
+                    .contains(&name.as_str())
+            {
+                csvs.push(p);
+            }
+        }
+    }
+    csvs.sort();
+    csvs
+}
+
 /// A CSV file's rows as they stand (stamp and six values, no checks), or `None` if it has
 /// none or is not there.
 fn raw_rows(path: &Path) -> Option<Vec<ImuSample>> {
@@ -103,24 +127,7 @@ fn shared_recordings_written_as_mcap_stream_to_the_same_bytes() {
         .collect();
     datasets.sort();
     for dataset in &datasets {
-        let mut csvs: Vec<PathBuf> = Vec::new();
-        let mut stack = vec![dataset.clone()];
-        while let Some(dir) = stack.pop() {
-            for e in std::fs::read_dir(&dir).unwrap() {
-                let p = e.unwrap().path();
-                let name = p.file_name().unwrap().to_string_lossy().to_string();
-                if p.is_dir() {
-                    stack.push(p);
-                } else if name.ends_with(".csv")
-                    && !name.ends_with(".reference.csv")
-                    && !["strides.csv", "events.csv", "trials.csv", "labels.csv"]
-                        .contains(&name.as_str())
-                {
-                    csvs.push(p);
-                }
-            }
-        }
-        csvs.sort();
+        let csvs = recordings_under(dataset);
         let mut here = 0;
         for p in &csvs {
             if here == 3 {
@@ -161,24 +168,7 @@ fn every_shared_recording_streams_to_the_same_bytes() {
     let Some(root) = root_or_skip("every_shared_recording_streams_to_the_same_bytes") else {
         return;
     };
-    let mut csvs: Vec<PathBuf> = Vec::new();
-    let mut stack = vec![root.clone()];
-    while let Some(d) = stack.pop() {
-        for e in std::fs::read_dir(&d).unwrap() {
-            let p = e.unwrap().path();
-            let name = p.file_name().unwrap().to_string_lossy().to_string();
-            if p.is_dir() {
-                stack.push(p);
-            } else if name.ends_with(".csv")
-                && !name.ends_with(".reference.csv")
-                && !["strides.csv", "events.csv", "trials.csv", "labels.csv"]
-                    .contains(&name.as_str())
-            {
-                csvs.push(p);
-            }
-        }
-    }
-    csvs.sort();
+    let csvs = recordings_under(&root);
     assert!(csvs.len() >= 300, "{} recordings", csvs.len());
     for p in &csvs {
         let [whole, streamed] = both(p, &ReadOptions::default(), Detector::Cycle, DEFAULT_MODEL);
