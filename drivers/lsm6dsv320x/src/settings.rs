@@ -196,6 +196,15 @@ impl Config {
         }
     }
 
+    /// How a board's sampler reads the part with this configuration: the FIFO whenever
+    /// INT1 says it holds [`Config::watermark_periods`] periods (at most 255: the watermark is
+    /// at most 255 words).
+    pub const fn read_mode(&self) -> gaitclip_imu::source::ReadMode {
+        gaitclip_imu::source::ReadMode::Watermark {
+            samples: self.watermark_periods() as u8,
+        }
+    }
+
     /// The two accelerometers as the FIFO's samples merge them: the high-g channel's range,
     /// or, with it off, ±32 g (the low-g counts rescaled, nothing to merge).
     pub const fn dual_range(&self) -> DualRange {

@@ -87,14 +87,6 @@ pub mod handle {
             &self.assembler
         }
 
-        /// The watermark read mode this configuration raises INT1 at.
-        pub const fn read_mode(&self) -> ReadMode {
-            let p = self.config.watermark_periods();
-            ReadMode::Watermark {
-                samples: if p > u8::MAX as u32 { u8::MAX } else { p as u8 },
-            }
-        }
-
         /// A FIFO emptied by the part or a reset: the period being assembled is gone with
         /// it (the caller's gap counts it), the merge's counts stay.
         fn forget_partial(&mut self) {

@@ -459,7 +459,7 @@ pub fn decode(path: &Path, bytes: &[u8], rate_hz: Option<f64>) -> Result<Trace, 
         return Err(imu.no_imu_channel());
     }
     let (samples, repeated) = Trace::drop_repeats(samples, rate_hz)
-        .map_err(|e| imu.time_goes_back(e.index, e.t_s, e.previous_s))?;
+        .map_err(|e| time_goes_back(path, imu.topic(), e.index, e.t_s, e.previous_s))?;
     let rate_hz = rate_hz
         .or_else(|| Trace::rate_from_timestamps(&samples))
         .unwrap_or(0.0);
@@ -605,11 +605,6 @@ impl<'p> ImuMessages<'p> {
             path: self.path.to_owned(),
             seen,
         }
-    }
-
-    /// [`time_goes_back`] on this file's IMU channel.
-    pub fn time_goes_back(&self, index: usize, t_s: f64, previous_s: f64) -> McapError {
-        time_goes_back(self.path, self.topic(), index, t_s, previous_s)
     }
 
     /// The IMU channel's topic ("" before one is chosen).

@@ -45,9 +45,7 @@ pub const CONFIG: Config = {
     c
 };
 /// How the sampler reads it: the FIFO whenever INT1 says it holds its watermark.
-pub const MODE: ReadMode = ReadMode::Watermark {
-    samples: SENSOR.watermark_periods() as u8,
-};
+pub const MODE: ReadMode = SENSOR.read_mode();
 /// When it sleeps and how it wakes: still for 10 s as the MPU6050 builds, then the low-g
 /// accelerometer alone at 15 Hz waking on 94 mg ([`MotionWakeConfig::DEFAULT`]). The 80 ms
 /// dropped after waking are not the LSM6DSV320X's own gyroscope turn-on time (its
