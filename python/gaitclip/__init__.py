@@ -36,6 +36,7 @@ import numpy as np
 import pandas as pd
 
 from . import _gaitclip
+from ._frame import frame_of
 
 __all__ = [
     "replay",
@@ -129,7 +130,9 @@ def _not_finite(frame: pd.DataFrame, columns: Dict[str, np.ndarray]) -> ValueErr
     return ValueError("a value is not a finite number")
 
 
-def _to_frame(native: Tuple[Dict[str, Any], str], all_models: bool) -> pd.DataFrame:
+def _to_frame(
+    native: Tuple[Dict[str, Any], str], all_models: bool, *, blocks: bool = True
+) -> pd.DataFrame:
     columns, summary = native
     rows = {ROWS[k[4:]]: v for k, v in columns.items() if k.startswith("row_")}
     rows["min_vel"] = rows["start"]
@@ -139,7 +142,7 @@ def _to_frame(native: Tuple[Dict[str, Any], str], all_models: bool) -> pd.DataFr
     data.update({c: named.pop(c) for c in PARAMETERS})
     data.update({c: rows[c] for c in ("heel_off", "foot_flat")})
     data.update(named)
-    frame = pd.DataFrame(data, index=pd.Index(s_id, name="s_id"), copy=False)
+    frame = frame_of(data, pd.Index(s_id, name="s_id"), blocks=blocks)
     frame.attrs["summary"] = json.loads(summary)
     return frame
 

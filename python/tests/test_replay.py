@@ -191,3 +191,41 @@ def test_a_rate_the_stamps_contradict_is_refused_and_a_low_rate_warns(datasets):
     # Every third row: 68 Hz, below the checked range: it replays, with the CLI's warning.
     with pytest.warns(gaitclip.GaitclipWarning, match="below 100 Hz"):
         gaitclip.replay(good.iloc[::3].reset_index(drop=True))
+
+
+def test_the_frame_built_from_blocks_is_the_plain_constructors(datasets):
+    """`_frame.frame_of` hands pandas one block per dtype (the Python layer's main cost is the
+    plain constructor): the frame must be the one `pd.DataFrame(dict)` builds, dtypes, order,
+    lists in `flags` and all, for every detector, with every model, and with no stride."""
+    from gaitclip import _gaitclip
+    from gaitclip._frame import _BUILD
+
+    assert _BUILD is not None, "the pinned pandas has a constructor from blocks"
+    walk = str(datasets / "gaitmap_walk" / "left.csv")
+    still = np.zeros((400, 3))
+    still[:, 2] = 9.81
+    cases = {
+        "cycle": (_gaitclip.replay_path(walk, None, "cycle", None, False, None, None, None, None, False), False),
+        "every model": (_gaitclip.replay_path(walk, None, "stance", None, True, None, None, None, None, False), True),
+        "lu": (_gaitclip.replay_path(walk, None, "lu", "lu_fuzzy", False, None, None, None, None, False), False),
+        "no stride": (
+            _gaitclip.replay_arrays(
+                np.arange(400) / 100.0, list(still.T.copy()), [np.zeros(400)] * 3,
+                "rad/s", 100.0, "cycle", None, False, None, None, None, False,
+            ),
+            False,
+        ),
+    }
+    for name, (native, all_models) in cases.items():
+        fast = gaitclip._to_frame(native, all_models)
+        plain = gaitclip._to_frame(native, all_models, blocks=False)
+        pd.testing.assert_frame_equal(fast, plain, check_exact=True, obj=name)
+        assert fast.attrs == plain.attrs, name
+        if len(fast):
+            assert fast._mgr.nblocks <= 4, f"{name}: {fast._mgr.nblocks} blocks"
+            assert isinstance(fast["flags"].iloc[0], list), name
+    assert len(gaitclip._to_frame(cases["no stride"][0], False)) == 0
+    # Frames of the same columns share no Index: naming one's columns names no other's.
+    a, b = (gaitclip._to_frame(cases["cycle"][0], False) for _ in range(2))
+    a.columns.name = "field"
+    assert b.columns.name is None
