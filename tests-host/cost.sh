@@ -94,7 +94,7 @@ echo "$report"
 echo
 echo "### Constant memory"
 echo
-echo "\`gaitclip replay --json\` of a week at 100 Hz: $long_samples samples of \`ipol_gait_events\`' walks one after another on a clean clock, a $((week_bytes / 1000000)) MB CSV; and of its first day written as MCAP, a $((day_bytes / 1000000)) MB file (the spool beside each, 64 bytes a sample, on disk):"
+echo "\`gaitclip replay --json\` of a week at 100 Hz: $long_samples samples of \`ipol_gait_events\`' walks one after another on a clean clock, a $((week_bytes / 1000000)) MB CSV; and of its first day written as MCAP, a $((day_bytes / 1000000)) MB file (the spool beside each, 64 bytes a sample: its first 8 MiB in memory, the rest on disk):"
 echo
 echo "| recording | samples | strides | peak resident memory | wall time | samples/s |"
 echo "|---|---:|---:|---:|---:|---:|"

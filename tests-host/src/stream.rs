@@ -1,9 +1,10 @@
 //! A recording (CSV or MCAP) replayed in constant memory: a week at 100 Hz is 60 M samples,
 //! and holding it (≈ 160 bytes a sample in the replay that reads it whole) would take 10 GB.
 //!
-//! **How.** The file is parsed once, row by row, into a spool on disk (64 bytes a row: the
-//! stamp, the six values, the line (CSV) or message index (MCAP) for the errors; deleted
-//! when the replay ends). An MCAP file is read twice for that, one record at a time
+//! **How.** The file is parsed once, row by row, into a spool (64 bytes a row: the stamp, the
+//! six values, the line (CSV) or message index (MCAP) for the errors): in memory up to
+//! [`MEMORY_SPOOL_BYTES`], on disk past it, in a file without a name that goes when the
+//! replay ends, however the process ends (a `| head -1` ends it by SIGPIPE). An MCAP file is read twice for that, one record at a time
 //! ([`crate::io::mcap_io::visit_records`]: its chunks' record lengths checked, then its
 //! records decoded), as the reader that reads it whole does. Every step
 //! that looks at the whole recording then reads the spool again from the start, in order,
@@ -35,7 +36,6 @@ use std::cell::RefCell;
 use std::fs::File;
 use std::io::{BufReader, BufWriter, Read, Write};
 use std::path::{Path, PathBuf};
-use std::sync::atomic::{AtomicU64, Ordering};
 
 use gaitclip::length::models::Model;
 use gaitclip::pipeline::config::Config;
@@ -65,9 +65,17 @@ pub enum StreamError {
     Replay(#[from] ReplayError),
 }
 
-/// A recording's rows on disk, to be read as often as needed; the file goes with it.
+/// A spool this small stays in memory, bytes (131 072 rows: 22 min at 100 Hz, 2.7 min at
+/// 800 Hz); a longer recording's goes to disk, where it is read back in every pass. On a
+/// short recording the file's creation and its passes' reads cost more than the replay (a
+/// 39 s walk: 15 ms against 9 ms read whole); the memory a replay holds stays bounded either
+/// way.
+pub const MEMORY_SPOOL_BYTES: usize = 8 << 20;
+
+/// A recording's rows in memory or on disk, to be read as often as needed; the file goes with
+/// it.
 pub struct Spool {
-    file: PathBuf,
+    store: Store,
     rows: usize,
     t_col: usize,
     source: PathBuf,
@@ -77,46 +85,37 @@ pub struct Spool {
     failed: RefCell<Option<std::io::Error>>,
 }
 
-/// A row of the spool.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct SpooledRow {
-    /// The sample as read (the file's units).
-    pub sample: ImuSample,
-    /// Its 1-based line in a CSV file; its 0-based index among an MCAP file's IMU
-    /// messages.
-    pub line: u64,
+/// Where a spool's rows are.
+enum Store {
+    /// Up to [`MEMORY_SPOOL_BYTES`].
+    Memory(Vec<u8>),
+    /// A file in the temporary folder without a name ([`tempfile::tempfile`]): gone when
+    /// its handle closes, however the process ends.
+    Disk(File),
 }
 
-impl Spool {
-    /// An empty spool for the recording `path`, its file created in the temporary folder
-    /// ([`std::env::temp_dir`]), and a writer to it.
-    fn create(
-        path: &Path,
-        mcap: bool,
-    ) -> Result<(Spool, BufWriter<File>), (PathBuf, std::io::Error)> {
-        static NEXT: AtomicU64 = AtomicU64::new(0);
-        let file = std::env::temp_dir().join(format!(
-            "gaitclip-{}-{}.spool",
-            std::process::id(),
-            NEXT.fetch_add(1, Ordering::Relaxed)
-        ));
-        let out = match File::create(&file) {
-            Ok(f) => BufWriter::with_capacity(1 << 20, f),
-            Err(e) => return Err((file, e)),
-        };
-        let spool = Spool {
-            file,
-            rows: 0,
-            t_col: 1,
-            source: path.to_owned(),
-            mcap,
-            failed: RefCell::new(None),
-        };
-        Ok((spool, out))
+/// Writes a spool's rows: into memory, then, past [`MEMORY_SPOOL_BYTES`], all of them into
+/// its file.
+struct SpoolWriter {
+    memory: Vec<u8>,
+    disk: Option<BufWriter<File>>,
+}
+
+impl SpoolWriter {
+    fn new() -> SpoolWriter {
+        SpoolWriter {
+            memory: Vec::new(),
+            disk: None,
+        }
     }
 
-    /// One row to `out`: the sample and its line (or index).
-    fn write_row(out: &mut impl Write, s: &ImuSample, line: u64) -> std::io::Result<()> {
+    /// Where a spool's file goes, for its errors (the file has no name).
+    fn folder() -> PathBuf {
+        std::env::temp_dir()
+    }
+
+    /// One row: the sample and its line (or index).
+    fn write_row(&mut self, s: &ImuSample, line: u64) -> std::io::Result<()> {
         let mut b = [0u8; ROW_BYTES];
         let v = [
             s.t_s,
@@ -131,7 +130,49 @@ impl Spool {
             b[8 * k..8 * k + 8].copy_from_slice(&x.to_le_bytes());
         }
         b[56..].copy_from_slice(&line.to_le_bytes());
-        out.write_all(&b)
+        if self.disk.is_none() && self.memory.len() + ROW_BYTES > MEMORY_SPOOL_BYTES {
+            let mut out = BufWriter::with_capacity(1 << 20, tempfile::tempfile()?);
+            out.write_all(&std::mem::take(&mut self.memory))?;
+            self.disk = Some(out);
+        }
+        match self.disk.as_mut() {
+            Some(out) => out.write_all(&b),
+            None => {
+                self.memory.extend_from_slice(&b);
+                Ok(())
+            }
+        }
+    }
+
+    /// The rows written, flushed to the file if they went there.
+    fn finish(self) -> std::io::Result<Store> {
+        match self.disk {
+            Some(out) => Ok(Store::Disk(out.into_inner().map_err(|e| e.into_error())?)),
+            None => Ok(Store::Memory(self.memory)),
+        }
+    }
+}
+
+/// A row of the spool.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct SpooledRow {
+    /// The sample as read (the file's units).
+    pub sample: ImuSample,
+    /// Its 1-based line in a CSV file; its 0-based index among an MCAP file's IMU
+    /// messages.
+    pub line: u64,
+}
+
+impl Spool {
+    fn of(path: &Path, mcap: bool, store: Store, rows: usize, t_col: usize) -> Spool {
+        Spool {
+            store,
+            rows,
+            t_col,
+            source: path.to_owned(),
+            mcap,
+            failed: RefCell::new(None),
+        }
     }
 
     /// Parses the CSV file `path` into a spool in the temporary folder
@@ -144,21 +185,18 @@ impl Spool {
         // A first read says what reading the whole file would (a folder: "Is a directory").
         let mut input = BufReader::with_capacity(1 << 20, File::open(path).map_err(io)?);
         std::io::BufRead::fill_buf(&mut input).map_err(io)?;
-        let (mut spool, mut out) =
-            Spool::create(path, false).map_err(|(path, source)| CsvError::Io { path, source })?;
-        let file = spool.file.clone();
+        let mut out = SpoolWriter::new();
         let spool_io = |source| CsvError::Io {
-            path: file.clone(),
+            path: SpoolWriter::folder(),
             source,
         };
         let mut rows = 0usize;
-        spool.t_col = csv_trace::parse_each(path, input, |s, line| {
+        let t_col = csv_trace::parse_each(path, input, |s, line| {
             rows += 1;
-            Spool::write_row(&mut out, &s, line).map_err(spool_io)
+            out.write_row(&s, line).map_err(spool_io)
         })?;
-        out.flush().map_err(spool_io)?;
-        spool.rows = rows;
-        Ok(spool)
+        let store = out.finish().map_err(spool_io)?;
+        Ok(Spool::of(path, false, store, rows, t_col))
     }
 
     /// Decodes the MCAP file `path` into a spool (its IMU channel's messages, in file
@@ -174,11 +212,9 @@ impl Spool {
         std::io::BufRead::fill_buf(&mut first).map_err(io)?;
         let len = first.get_ref().metadata().map_err(io)?.len();
         drop(first);
-        let (mut spool, mut out) =
-            Spool::create(path, true).map_err(|(path, source)| McapError::Io { path, source })?;
-        let file = spool.file.clone();
+        let mut out = SpoolWriter::new();
         let spool_io = |source| McapError::Io {
-            path: file.clone(),
+            path: SpoolWriter::folder(),
             source,
         };
         let mut imu = ImuMessages::new(path);
@@ -198,7 +234,7 @@ impl Spool {
             }
             match imu.take(r, rows) {
                 Ok(Some(s)) => {
-                    Spool::write_row(&mut out, &s, rows as u64).map_err(spool_io)?;
+                    out.write_row(&s, rows as u64).map_err(spool_io)?;
                     rows += 1;
                 }
                 Ok(None) => {}
@@ -212,9 +248,11 @@ impl Spool {
         if rows == 0 {
             return Err(imu.no_imu_channel());
         }
-        out.flush().map_err(spool_io)?;
-        spool.rows = rows;
-        Ok((spool, imu.topic().to_owned()))
+        let store = out.finish().map_err(spool_io)?;
+        Ok((
+            Spool::of(path, true, store, rows, 1),
+            imu.topic().to_owned(),
+        ))
     }
 
     /// Rows in the spool.
@@ -224,12 +262,12 @@ impl Spool {
 
     /// The rows, in order, read again from the start.
     pub fn read(&self) -> SpoolRows<'_> {
-        let reader = match File::open(&self.file) {
-            Ok(f) => Some(BufReader::with_capacity(1 << 20, f)),
-            Err(e) => {
-                self.failed.borrow_mut().get_or_insert(e);
-                None
-            }
+        let reader = match &self.store {
+            Store::Memory(rows) => Some(Rows::Memory(rows)),
+            Store::Disk(file) => Some(Rows::Disk(BufReader::with_capacity(
+                1 << 20,
+                FileAt { file, at: 0 },
+            ))),
         };
         SpoolRows {
             spool: self,
@@ -251,16 +289,43 @@ impl Spool {
     }
 }
 
-impl Drop for Spool {
-    fn drop(&mut self) {
-        let _ = std::fs::remove_file(&self.file);
+/// A pass over a spool's rows: the bytes left in memory, or the file.
+enum Rows<'a> {
+    Memory(&'a [u8]),
+    Disk(BufReader<FileAt<'a>>),
+}
+
+/// A file read from `at` on, by position: passes over one file handle, each with its own
+/// place (a cloned handle would share one).
+struct FileAt<'a> {
+    file: &'a File,
+    at: u64,
+}
+
+impl Read for FileAt<'_> {
+    fn read(&mut self, buf: &mut [u8]) -> std::io::Result<usize> {
+        #[cfg(unix)]
+        let n = std::os::unix::fs::FileExt::read_at(self.file, buf, self.at)?;
+        #[cfg(windows)]
+        let n = std::os::windows::fs::FileExt::seek_read(self.file, buf, self.at)?;
+        self.at += n as u64;
+        Ok(n)
+    }
+}
+
+impl Read for Rows<'_> {
+    fn read(&mut self, buf: &mut [u8]) -> std::io::Result<usize> {
+        match self {
+            Rows::Memory(rows) => rows.read(buf),
+            Rows::Disk(file) => file.read(buf),
+        }
     }
 }
 
 /// The rows of a [`Spool`], in order.
 pub struct SpoolRows<'a> {
     spool: &'a Spool,
-    reader: Option<BufReader<File>>,
+    reader: Option<Rows<'a>>,
     left: usize,
 }
 

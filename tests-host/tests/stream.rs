@@ -366,3 +366,51 @@ fn faults_stream_to_the_same_bytes_and_errors() {
     );
     let _ = std::fs::remove_dir_all(d);
 }
+
+/// A recording too long for the spool in memory ([`gaitclip_host::stream::MEMORY_SPOOL_BYTES`])
+/// goes to its file part-way through: two of the shared courses end to end (146 k rows at
+/// 800 Hz), as CSV and as MCAP, stream to the bytes the whole replay gives.
+#[test]
+fn a_recording_past_the_memory_spool_streams_to_the_same_bytes() {
+    let Some(root) = root_or_skip("a_recording_past_the_memory_spool_streams_to_the_same_bytes")
+    else {
+        return;
+    };
+    let courses = recordings_under(&root.join("esangeni_course"));
+    let mut rows: Vec<ImuSample> = Vec::new();
+    for p in courses.iter().take(2) {
+        let t = recording::read(p, &ReadOptions::default()).unwrap();
+        // The second course's stamps go on from the first's, a period apart.
+        let shift = rows
+            .last()
+            .map_or(0.0, |l| l.t_s + 1.0 / t.rate_hz - t.samples[0].t_s);
+        rows.extend(t.samples.iter().map(|s| ImuSample {
+            t_s: s.t_s + shift,
+            ..*s
+        }));
+    }
+    let past = gaitclip_host::stream::MEMORY_SPOOL_BYTES / gaitclip_host::stream::ROW_BYTES;
+    assert!(
+        rows.len() > past,
+        "{} rows, the memory spool holds {past}",
+        rows.len()
+    );
+    let d = scratch("stream-long");
+    let csv = d.join("long.csv");
+    let mut f = std::io::BufWriter::new(std::fs::File::create(&csv).unwrap());
+    gaitclip_host::io::csv_trace::write(&mut f, &rows).unwrap();
+    drop(f);
+    let mcap = d.join("long.mcap");
+    write_mcap(&mcap, &rows);
+    let o = ReadOptions {
+        rate_hz: Some(800.0),
+        ..ReadOptions::default()
+    };
+    for p in [&csv, &mcap] {
+        let [whole, streamed] = both(p, &o, Detector::Cycle, DEFAULT_MODEL);
+        assert!(!whole.starts_with("error"), "{}: {whole}", p.display());
+        assert!(whole.lines().count() > 100, "{}: {whole}", p.display());
+        assert!(whole == streamed, "{}: streamed differs", p.display());
+    }
+    let _ = std::fs::remove_dir_all(d);
+}
