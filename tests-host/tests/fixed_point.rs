@@ -48,6 +48,19 @@ fn isqrt_is_exact() {
         let x: u64 = r.random::<u64>() >> r.random_range(0..64);
         let s = isqrt_u64(x) as u128;
         assert!(s * s <= x as u128 && (s + 1) * (s + 1) > x as u128, "{x}");
+        assert_eq!(isqrt_u64(x), x.isqrt(), "{x}");
+    }
+    // Where a root computed in f64 is most likely off: either side of a square, for every
+    // root below 2²⁰ and random ones up to 2³², and the ends of the range.
+    let roots = (0..1u64 << 20).chain((0..200_000).map(|_| r.random_range(0..=u32::MAX as u64)));
+    for k in roots.chain([u32::MAX as u64 - 1, u32::MAX as u64]) {
+        let sq = k * k;
+        for x in [sq.saturating_sub(1), sq, sq.saturating_add(1), sq + 2 * k] {
+            assert_eq!(isqrt_u64(x), x.isqrt(), "{x}");
+        }
+    }
+    for x in [0, 1, 2, 3, u64::MAX - 1, u64::MAX] {
+        assert_eq!(isqrt_u64(x), x.isqrt(), "{x}");
     }
 }
 
