@@ -89,3 +89,28 @@ fn a_repeated_stamp_is_dropped_not_fatal() {
         "the first of the repeats is kept"
     );
 }
+
+/// Whitespace around a header's names and a row's cells is no part of them (ASCII and
+/// Unicode alike, as csv's `Trim::All` read them); a bad padded cell is quoted trimmed, and a
+/// missing column's header is listed trimmed.
+#[test]
+fn padded_names_and_cells_are_trimmed() {
+    let text = " t_s ,\tacc_x, acc_y ,acc_z\u{a0},gyr_x , gyr_y,gyr_z\r\n 0.5 ,\t1, 2 ,3\u{a0},4 , 5,6\r\n";
+    let s = parse(Path::new("w.csv"), text.as_bytes()).unwrap();
+    assert_eq!(s[0].t_s, 0.5);
+    assert_eq!(s[0].acc_mps2, [1.0, 2.0, 3.0]);
+    assert_eq!(s[0].gyr_radps, [4.0, 5.0, 6.0]);
+    let text = " t_s , acc_x,acc_y,acc_z,gyr_x,gyr_y,gyr_z\n0, 1,2,  x y ,4,5,6\n";
+    let e = parse(Path::new("w.csv"), text.as_bytes()).unwrap_err();
+    assert_eq!(
+        e.to_string(),
+        "w.csv:2:4: column `acc_z`: `x y` is not a finite number"
+    );
+    let text = " t_s , acc_x,acc_y,acc_z,gyr_x,gyr_y\n0,1,2,3,4,5\n";
+    let e = parse(Path::new("w.csv"), text.as_bytes()).unwrap_err();
+    assert!(
+        e.to_string().contains("missing column `gyr_z`")
+            && e.to_string().contains("t_s,acc_x,acc_y,acc_z,gyr_x,gyr_y"),
+        "{e}"
+    );
+}
