@@ -28,7 +28,7 @@
 //! handle or refuse). What grows with the recording is what it
 //! holds: its holes (16 bytes each; `ipol_gait_events`' lossy link loses 2 % of its packets in
 //! holes of 1–11) and the movements the step check refuses (a few per minute of not
-//! walking). A week at 100 Hz of walks (60 M samples) peaks at about 10 MiB
+//! walking). A week at 100 Hz of walks (60 M samples) peaks at about 14 MiB
 //! (`tests-host/cost.sh`, docs/cost.md). A replay that writes the samples back out
 //! (`--mcap-out`) still reads the recording whole.
 
