@@ -259,7 +259,8 @@ fn kmeans(extremes: &[Extreme], len: u32) -> (u32, u32) {
 
 /// `extremes` are one axis's, in order ([`find_extremes`] gives them so): each peak pairs with
 /// the valley nearest before it, which is the last valley seen, so one pass pairs them all
-/// (a search of every valley per peak was a fifth of the phase split's time).
+/// (a search of every valley per peak was half the phase split: M4 62 672 → 31 516
+/// instructions per stride, docs/cost.md).
 fn major_pair<'a>(extremes: impl Iterator<Item = &'a Extreme> + Clone, merge: u32) -> Option<Pair> {
     let pairs = extremes.scan(None::<Extreme>, |last_valley, e| {
         Some(if e.peak {
