@@ -178,3 +178,57 @@ fn a_shell_pipe_into_head_is_quiet() {
     );
     assert!(!err.contains("panicked"), "{err}");
 }
+
+/// A replay ended by SIGPIPE leaves nothing in the temporary folder: its spool on disk has no
+/// name. A recording longer than the spool held in memory (the demo walk 22 times over,
+/// 139 k rows) replayed into a closed pipe with its own `TMPDIR`, which must be empty after.
+/// (A named spool, deleted by its destructor, stayed there: a signal runs no destructor.)
+#[test]
+fn a_replay_ended_by_sigpipe_leaves_no_spool() {
+    use gaitclip_host::io::csv_trace;
+    use gaitclip_host::io::trace::ImuSample;
+    use gaitclip_host::stream::{MEMORY_SPOOL_BYTES, ROW_BYTES};
+
+    let walk = csv_trace::read(std::path::Path::new(&demo()), None).unwrap();
+    let period = 1.0 / walk.rate_hz;
+    let mut rows: Vec<ImuSample> = Vec::new();
+    for _ in 0..22 {
+        let shift = rows
+            .last()
+            .map_or(0.0, |l| l.t_s + period - walk.samples[0].t_s);
+        rows.extend(walk.samples.iter().map(|s| ImuSample {
+            t_s: s.t_s + shift,
+            ..*s
+        }));
+    }
+    assert!(
+        rows.len() > MEMORY_SPOOL_BYTES / ROW_BYTES,
+        "{} rows",
+        rows.len()
+    );
+    let dir = std::env::temp_dir().join(format!("gaitclip-pipes-spool-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    let tmp = dir.join("tmp");
+    std::fs::create_dir_all(&tmp).unwrap();
+    let long = dir.join("long.csv");
+    let mut f = std::io::BufWriter::new(std::fs::File::create(&long).unwrap());
+    csv_trace::write(&mut f, &rows).unwrap();
+    drop(f);
+    let (reader, writer) = std::io::pipe().unwrap();
+    drop(reader);
+    let out = Command::new(env!("CARGO_BIN_EXE_gaitclip"))
+        .args(["replay", long.to_str().unwrap()])
+        .env("TMPDIR", &tmp)
+        .stdout(Stdio::from(writer))
+        .stderr(Stdio::piped())
+        .output()
+        .unwrap();
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.signal(), Some(SIGPIPE), "{:?} {err}", out.status);
+    let left: Vec<_> = std::fs::read_dir(&tmp)
+        .unwrap()
+        .map(|e| e.unwrap().path())
+        .collect();
+    assert!(left.is_empty(), "left in TMPDIR: {left:?}");
+    let _ = std::fs::remove_dir_all(dir);
+}
