@@ -159,6 +159,44 @@ pub fn isqrt_u64(x: u64) -> u64 {
     }
 }
 
+/// Exact `floor(sqrt(x))` of a `u128`, over the whole range.
+///
+/// On the microcontrollers it is the standard library's integer square root. On a 64-bit
+/// host (where the standard one was a twentieth of the replay's time: the attitude levelled
+/// at every candidate stance instant takes two) it starts from the `f64` root. `x` rounded
+/// to `f64` is within 2⁻⁵³ of it relatively, so the truncated root `r` is within
+/// `1 + √x·2⁻⁵³` of `⌊√x⌋`: one off below 2¹⁰⁴, up to 2¹¹ above. Above, one Newton step
+/// `(r + x/r)/2` brings it within one (the error squared over twice the root, plus the
+/// truncations); one step each way then makes it exact. A host test compares it with the
+/// standard library's on both sides of squares at every size and on random values.
+#[inline]
+pub fn isqrt_u128(x: u128) -> u128 {
+    #[cfg(any(target_arch = "x86_64", target_arch = "aarch64"))]
+    {
+        if x <= u64::MAX as u128 {
+            return isqrt_u64(x as u64) as u128;
+        }
+        // ≥ 2³² here, ≤ 2⁶⁴ (the root of x rounded up to 2¹²⁸).
+        let mut r = libm::sqrt(x as f64) as u128;
+        if x >= 1 << 104 {
+            r = (r + x / r) / 2;
+        }
+        // r < 2⁶⁴ + 2¹¹: r² and (r+1)² fit in a u128 except at the very top, where the
+        // checked product says "above x".
+        while r.checked_mul(r).is_none_or(|sq| sq > x) {
+            r -= 1;
+        }
+        while (r + 1).checked_mul(r + 1).is_some_and(|sq| sq <= x) {
+            r += 1;
+        }
+        r
+    }
+    #[cfg(not(any(target_arch = "x86_64", target_arch = "aarch64")))]
+    {
+        x.isqrt()
+    }
+}
+
 /// Unit quaternion in Q30, `w + xi + yj + zk`, rotating sensor-frame vectors into the
 /// navigation frame: `v_nav = q · v_sensor · q*`.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -265,7 +303,7 @@ impl QuatQ30 {
         if n2 == 0 {
             return None;
         }
-        let n = n2.isqrt() as i128;
+        let n = isqrt_u128(n2) as i128;
         if n == 0 {
             return None;
         }
@@ -292,7 +330,7 @@ impl QuatQ30 {
         }
         // Scaled by 2²⁰ before the root so that its truncation costs < 2⁻⁴⁰ of the length.
         let n2_scaled = n2 << 40;
-        let n = n2_scaled.isqrt() as i128;
+        let n = isqrt_u128(n2_scaled) as i128;
         let u = |v: i64| div_round_i128((v as i128) << 50, n) as i64;
         let (ux, uy, uz) = (u(up[0]), u(up[1]), u(up[2]));
         // The half-way quaternion [1 + u·z, u × z] is singular for u = −z, so a sensor that

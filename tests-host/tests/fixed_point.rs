@@ -4,7 +4,7 @@
 use gaitclip::detect::rest::{RestSums, RestThresholds, ACCEL_STD_MAX_MMPS2, GYRO_RMS_MAX_MRADPS};
 use gaitclip::detect::stance::{deflate, StanceThresholds, DEFLATED_IQR_MAX, DEFLATED_STD_MAX};
 use gaitclip::detect::zupt::ZuptIntegrator;
-use gaitclip::fixed::{isqrt_u64, mul_q30, QuatQ30, Q30_ONE};
+use gaitclip::fixed::{isqrt_u128, isqrt_u64, mul_q30, QuatQ30, Q30_ONE};
 use gaitclip::sensor::rate::SampleRate;
 use gaitclip::sensor::sample::RawSample;
 use gaitclip::sensor::units::{AccelScale, GyroScale};
@@ -61,6 +61,46 @@ fn isqrt_is_exact() {
     }
     for x in [0, 1, 2, 3, u64::MAX - 1, u64::MAX] {
         assert_eq!(isqrt_u64(x), x.isqrt(), "{x}");
+    }
+}
+
+#[test]
+fn isqrt_u128_is_exact() {
+    let mut r = rng();
+    for _ in 0..200_000 {
+        let x: u128 = r.random::<u128>() >> r.random_range(0..128);
+        assert_eq!(isqrt_u128(x), x.isqrt(), "{x}");
+    }
+    // Either side of a square, for roots of every size up to 2⁶⁴ − 1 (the f64 root is
+    // rounded, and above 2¹⁰⁴ corrected by a Newton step), and the ends of the range.
+    let roots = (0..100_000u128)
+        .chain((1..=64).flat_map(|bits: u32| {
+            let top = if bits == 64 {
+                u64::MAX as u128
+            } else {
+                (1u128 << bits) - 1
+            };
+            [top, top - top / 3, top / 2 + 1]
+        }))
+        .chain((0..200_000).map(|_| (r.random::<u64>() >> r.random_range(0..40)) as u128));
+    for k in roots {
+        let sq = k * k;
+        for x in [sq.saturating_sub(1), sq, sq + 1, sq + 2 * k] {
+            assert_eq!(isqrt_u128(x), x.isqrt(), "{x}");
+        }
+    }
+    for x in [
+        0,
+        1,
+        2,
+        3,
+        u64::MAX as u128,
+        1 << 104,
+        (1 << 104) - 1,
+        u128::MAX - 1,
+        u128::MAX,
+    ] {
+        assert_eq!(isqrt_u128(x), x.isqrt(), "{x}");
     }
 }
 
