@@ -330,6 +330,38 @@ struct Current {
     broken: Option<(u32, usize)>,
 }
 
+/// Which integrator a [`Start`] is for.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum Starting {
+    /// The stride's, restarted at rest ([`Current::integrator`]).
+    Current,
+    /// The next stride's, from the candidate ([`CycleDetector::next`]).
+    Next,
+}
+
+/// An integrator's start at a stance instant, not made yet: what
+/// [`ZuptIntegrator::start_at`] is given there, and the first sample after it.
+///
+/// At rest the stance instant moves on with every sample, and while the energy falls into a
+/// stance every sample is a deeper candidate: each started an integrator (the attitude
+/// levelled from gravity, two 128-bit roots, the rolling contact's velocity) that the next
+/// sample threw away. Deferred by one sample, a start is made only for an instant that
+/// outlived the sample after it, or that something reads. The same samples are integrated in
+/// the same order from the same start, so every stride is the same to the bit.
+#[derive(Clone, Copy, Debug)]
+struct Start {
+    of: Starting,
+    /// The stance's gravity (counts·2⁸, sensor axes), never zero.
+    mean: [i64; 3],
+    /// Rate there, less the bias, counts.
+    omega: [i32; 3],
+    gyro_bias: [i32; 3],
+    /// Gravity's magnitude, counts·2⁸, positive.
+    gravity_q8: i64,
+    /// The first sample after the instant, not integrated yet.
+    first: Option<RawSample>,
+}
+
 /// The every-pace stance detector and its strides, keeping at most `M` samples of a
 /// movement.
 #[derive(Clone, Debug)]
@@ -344,6 +376,8 @@ pub struct CycleDetector<const M: usize> {
     cand: Option<Candidate>,
     /// The integrator started at the candidate.
     next: ZuptIntegrator,
+    /// The start of the stride's integrator or the next one's, deferred ([`Start`]).
+    pending: Option<Start>,
     /// Largest energy since the stance instant (or since the candidate, once there is one).
     peak: u64,
     peak_since_cand: u64,
@@ -414,6 +448,7 @@ impl<const M: usize> CycleDetector<M> {
             cur: None,
             cand: None,
             next: cfg.integrator,
+            pending: None,
             peak: 0,
             peak_since_cand: 0,
             low_sum: [0; 3],
@@ -463,6 +498,61 @@ impl<const M: usize> CycleDetector<M> {
         2 * self.cfg.half + 1
     }
 
+    /// Sample `s` into the stride's integrator or the next one's (`which`): held as the
+    /// first sample after a deferred start, or integrated (after that start is made).
+    fn integrate(&mut self, which: Starting, s: &RawSample) {
+        if let Some(p) = self.pending.as_mut().filter(|p| p.of == which) {
+            if p.first.is_none() {
+                p.first = Some(*s);
+                return;
+            }
+            self.settle();
+        }
+        match which {
+            Starting::Current => {
+                if let Some(c) = self.cur.as_mut() {
+                    c.integrator.process(s, &self.cfg.rails);
+                }
+            }
+            Starting::Next => self.next.process(s, &self.cfg.rails),
+        }
+    }
+
+    /// Defers a start at a stance instant ([`Start`]), making one of the other integrator
+    /// that is still pending first.
+    fn defer(&mut self, start: Start) {
+        if self.pending.is_some_and(|p| p.of != start.of) {
+            self.settle();
+        }
+        self.pending = Some(start);
+    }
+
+    /// Makes the deferred start, if any, and integrates the sample held after it. Not
+    /// inlined: the started integrator (≈ 300 B) is written in place.
+    #[inline(never)]
+    fn settle(&mut self) {
+        let Some(p) = self.pending.take() else {
+            return;
+        };
+        let it = match p.of {
+            Starting::Current => match self.cur.as_mut() {
+                Some(c) => &mut c.integrator,
+                None => return,
+            },
+            Starting::Next => &mut self.next,
+        };
+        // `mean` is not zero and the gravity positive (checked when deferred): both succeed.
+        *it = self.cfg.integrator;
+        if let Some(level) = QuatQ30::level_from_up(p.mean) {
+            let unit_q8 = self.cfg.integrator.unit_q8_for(p.gravity_q8);
+            let v0 = self.cfg.rolling.velocity_q8(level, p.omega, unit_q8);
+            let _ = it.start_at(level, p.gyro_bias, p.gravity_q8, v0);
+        }
+        if let Some(first) = p.first.as_ref() {
+            it.process(first, &self.cfg.rails);
+        }
+    }
+
     /// Samples were lost and detection restarts: the stride in progress is reported, at
     /// the next stance, as a gap stride. A candidate the swing after it has already risen
     /// from is kept and confirmed at the next input (on the sample path's stack, not the
@@ -491,6 +581,10 @@ impl<const M: usize> CycleDetector<M> {
                 c.broken = c.broken.or(Some(hole));
             }
             self.cand = None;
+            // The next stride's start goes with its candidate.
+            if self.pending.is_some_and(|p| p.of == Starting::Next) {
+                self.pending = None;
+            }
         }
         self.in_low = false;
         self.low_n = 0;
@@ -560,10 +654,10 @@ impl<const M: usize> CycleDetector<M> {
 
         // The stride's integrator and the next one's take this sample.
         let in_low = self.in_low;
+        if self.cur.as_ref().is_some_and(|c| i != c.start) {
+            self.integrate(Starting::Current, s);
+        }
         if let Some(c) = self.cur.as_mut() {
-            if i != c.start {
-                c.integrator.process(s, &self.cfg.rails);
-            }
             // After a candidate the samples are the next stride's (below).
             if self.cand.is_none() {
                 mark(
@@ -587,9 +681,11 @@ impl<const M: usize> CycleDetector<M> {
                 self.mv_gap = None;
             }
         }
+        if self.cand.as_ref().is_some_and(|c| i != c.index) {
+            self.integrate(Starting::Next, s);
+        }
         if let Some(c) = self.cand.as_mut() {
             if i != c.index {
-                self.next.process(s, &self.cfg.rails);
                 mark(
                     &mut c.next_flags,
                     s,
@@ -686,6 +782,9 @@ impl<const M: usize> CycleDetector<M> {
             return;
         }
         let first = self.cur.is_none();
+        if self.pending.is_some_and(|p| p.of == Starting::Current) {
+            self.settle();
+        }
         if let Some(c) = self.cur.as_ref() {
             if !agrees(&c.integrator.attitude(), &mean) {
                 return;
@@ -728,14 +827,10 @@ impl<const M: usize> CycleDetector<M> {
         cal: &Calibration,
         gravity_q8: i64,
     ) {
-        let Some(level) = QuatQ30::level_from_up(mean) else {
-            return;
-        };
-        if gravity_q8 <= 0 {
+        // The gravity levels the attitude unless it is zero (`QuatQ30::level_from_up`).
+        if mean == [0; 3] || gravity_q8 <= 0 {
             return;
         }
-        let unit_q8 = self.cfg.integrator.unit_q8_for(gravity_q8);
-        let v0 = self.cfg.rolling.velocity_q8(level, omega, unit_q8);
         // Where the stride's movement ends in the buffer: at this low stretch's start. A
         // candidate that replaces one after the energy rose (a slow swing's dip) keeps the
         // samples stored since that one's "heel-off" after the movement so far.
@@ -782,9 +877,19 @@ impl<const M: usize> CycleDetector<M> {
             }
         };
         // The next stride's integrator, started in place (an integrator is ≈ 300 B and the
-        // M0's stack is small); it cannot refuse a positive gravity.
-        self.next = self.cfg.integrator;
-        let _ = self.next.start_at(level, cal.gyro_bias, gravity_q8, v0);
+        // M0's stack is small) once the instant outlives the next sample; at once for the
+        // first stance, whose stride starts from it as it is.
+        self.defer(Start {
+            of: Starting::Next,
+            mean,
+            omega,
+            gyro_bias: cal.gyro_bias,
+            gravity_q8,
+            first: None,
+        });
+        if self.cur.is_none() {
+            self.settle();
+        }
         // The stride's flags: up to the first candidate, and since it (a candidate that
         // replaces another extends the stride over the samples after that one).
         let flags = self.cur.as_ref().map_or(0, |c| c.flags)
@@ -826,22 +931,27 @@ impl<const M: usize> CycleDetector<M> {
         from_rest: bool,
     ) {
         let mean = self.low_sum.map(|v| (v << 8) / self.low_n.max(1) as i64);
-        let Some(level) = QuatQ30::level_from_up(mean) else {
-            return;
-        };
-        let unit_q8 = self.cfg.integrator.unit_q8_for(gravity_q8);
-        let v0 = self.cfg.rolling.velocity_q8(level, omega, unit_q8);
-        let mut it = self.cfg.integrator;
-        if !it.start_at(level, cal.gyro_bias, gravity_q8, v0) {
+        // The gravity levels the attitude unless it is zero (`QuatQ30::level_from_up`).
+        if mean == [0; 3] || gravity_q8 <= 0 {
             return;
         }
-        self.cur = Some(Current {
-            start: i,
-            energy: t,
-            integrator: it,
-            heel_off: None,
-            flags: if from_rest { StrideFlags::FROM_REST } else { 0 },
-            broken: None,
+        // In place; its integrator starts once the instant outlives the next sample (at
+        // rest it moves on with every sample).
+        let Some(c) = self.cur.as_mut() else {
+            return;
+        };
+        c.start = i;
+        c.energy = t;
+        c.heel_off = None;
+        c.flags = if from_rest { StrideFlags::FROM_REST } else { 0 };
+        c.broken = None;
+        self.defer(Start {
+            of: Starting::Current,
+            mean,
+            omega,
+            gyro_bias: cal.gyro_bias,
+            gravity_q8,
+            first: None,
         });
         self.movement.clear();
         self.mv_gap = None;
@@ -853,6 +963,11 @@ impl<const M: usize> CycleDetector<M> {
     /// while it runs, not under every sample's decision.
     #[inline(never)]
     fn confirm(&mut self, out: &mut Option<Stride>) {
+        if self.cand.is_none() {
+            return;
+        }
+        // The next stride starts from the candidate's integrator, as it is now.
+        self.settle();
         let Some(c) = self.cand.as_ref() else {
             return;
         };
@@ -1041,6 +1156,7 @@ impl<const M: usize> CycleDetector<M> {
             self.confirm(out);
         }
         self.cur = None;
+        self.pending = None;
     }
 }
 
