@@ -734,7 +734,7 @@ pub fn prepare(trace: &Trace, ranges: Ranges) -> Result<Prepared, ReplayError> {
     let mhz = (clock.rate_hz() * 1000.0).round();
     let rate = SampleRate::from_millihertz(mhz.clamp(0.0, u32::MAX as f64) as u32)
         .ok_or(ReplayError::Rate(clock.rate_hz()))?;
-    let counts: Vec<RawSample> = samples.iter().map(|s| ranges.to_counts(s)).collect();
+    let counts: Vec<RawSample> = samples.iter().map(ranges.converter()).collect();
     let rails = rails::learn_counted(&samples, &counts, ranges, trace.given);
     // Holes inside a host's bursts, placed by the angular rate.
     clock.place_holes(&stamps, |row| counts[row].gyro.map(|v| v as f64));

@@ -572,12 +572,13 @@ impl Streamed {
         let mhz = (clock.rate_hz() * 1000.0).round();
         let rate = SampleRate::from_millihertz(mhz.clamp(0.0, u32::MAX as f64) as u32)
             .ok_or(ReplayError::Rate(clock.rate_hz()))?;
-        let counts = || self.samples().map(move |s| ranges.to_counts(&s));
+        let convert = ranges.converter();
+        let counts = || self.samples().map(move |s| convert(&s));
         let rails: RailsReport =
             rails::learn_counted_of(&|| self.samples(), counts(), ranges, self.given);
         clock.place_holes_of(
             self.samples()
-                .map(|s| (s.t_s, ranges.to_counts(&s).gyro.map(|v| v as f64))),
+                .map(|s| (s.t_s, convert(&s).gyro.map(|v| v as f64))),
         );
         let mut config = Config::new(rate, ranges.accel.scale(), ranges.gyro.scale());
         config.rails = rails.rails;

@@ -240,7 +240,7 @@ pub fn report(inp: &Inputs) -> Result<String> {
     let csv = inp.datasets.join(dataset).join(format!("{trial}.csv"));
     let trace = crate::io::csv_trace::read(&csv, Some(rate_hz))?;
     let ranges = Ranges::default();
-    let counts: Vec<_> = trace.samples.iter().map(|s| ranges.to_counts(s)).collect();
+    let counts: Vec<_> = trace.samples.iter().map(ranges.converter()).collect();
     let name = format!("{dataset}_{trial}");
     crate::sim::fixtures::write_trace_module(
         &inp.scratch,

@@ -74,7 +74,7 @@ pub fn evaluate_at(dir: &Path, threshold_mg: u32) -> Result<WakeResult> {
         let trace = crate::io::csv_trace::read(&trial.csv, Some(ds.rate_hz))
             .with_context(|| trial.csv.display().to_string())?;
         let rate = trace.sample_rate().context("trace rate")?;
-        let counts: Vec<_> = trace.samples.iter().map(|s| ranges.to_counts(s)).collect();
+        let counts: Vec<_> = trace.samples.iter().map(ranges.converter()).collect();
         let mut p = Pipeline::new(Config::new(rate, ranges.accel.scale(), ranges.gyro.scale()));
         let mut stride_starts = Vec::new();
         let mut rest: Vec<bool> = Vec::with_capacity(counts.len());

@@ -202,7 +202,7 @@ fn plateaus<I: Iterator<Item = ImuSample>>(
 /// The rails of `samples`, converted at `ranges` (the core's counts), with the nominal
 /// ranges `given` where known.
 pub fn learn(samples: &[ImuSample], ranges: Ranges, given: GivenRanges) -> RailsReport {
-    let counts: Vec<RawSample> = samples.iter().map(|s| ranges.to_counts(s)).collect();
+    let counts: Vec<RawSample> = samples.iter().map(ranges.converter()).collect();
     learn_counted(samples, &counts, ranges, given)
 }
 
