@@ -33,7 +33,7 @@ use crate::eval::markdown::{Column, Table};
 use crate::eval::stats::{median, quantile};
 use crate::io::datasets;
 use crate::io::trace::Ranges;
-use crate::replay::{self, StrideReport};
+use crate::replay::{self, RejectedReport, StrideReport};
 use crate::{io::csv_trace, replay::Summary};
 
 /// A turning step turns the foot by this much or more, degrees (the step check's turn on
@@ -133,6 +133,23 @@ pub fn split(travel_deg: &[f64], length_m: &[f64]) -> Vec<Part> {
         .collect()
 }
 
+/// Movements the step check refused in pairs cut where the foot never rested: the first with
+/// a rest before it only, the second, straight after it, with a rest after it only. Each such
+/// pair is one movement of the foot cut at a zero-velocity instant that the rest test does not
+/// confirm (a stride split in two, and both halves refused): their count, and the distance
+/// the halves' own integrations moved the foot, m (the sum of both halves, an upper bound).
+pub fn split_refused(movements: &[RejectedReport]) -> (usize, f64) {
+    movements
+        .windows(2)
+        .filter(|w| {
+            let (a, b) = (&w[0], &w[1]);
+            a.end_s == b.start_s && a.rest_before && !a.rest_after && !b.rest_before && b.rest_after
+        })
+        .fold((0, 0.0), |(n, m), w| {
+            (n + 1, m + w[0].horizontal_m + w[1].horizontal_m)
+        })
+}
+
 /// One course replayed: its strides and summary.
 pub struct Course {
     /// Its geometry.
@@ -193,6 +210,7 @@ pub fn report(root: &Path) -> Result<String> {
         Column::right("|climb| median / p95 / max m"),
         Column::right("over 0.3 m"),
         Column::right("flagged"),
+        Column::right("refused halves of one movement (m)"),
     ]);
     let mut totals = Vec::new();
     for c in &courses {
@@ -219,6 +237,7 @@ pub fn report(root: &Path) -> Result<String> {
             *flags.entry(f).or_default() += 1;
         }
         let flagged = c.strides.iter().filter(|s| !s.flags.is_empty()).count();
+        let (split, split_m) = split_refused(&c.summary.rejected_movements);
         totals.push(100.0 * (c.summary.distance_m - c.truth.course_m) / c.truth.course_m);
         t.row([
             c.truth.trial.clone(),
@@ -273,11 +292,12 @@ pub fn report(root: &Path) -> Result<String> {
                         .join(", ")
                 )
             },
+            format!("{split} ({split_m:.2})"),
         ]);
     }
     let abs: Vec<f64> = totals.iter().map(|e| e.abs()).collect();
     Ok(format!(
-        "`esangeni_course`, each course's reported distance (the foot pod's total: every stride with a length) against its geometry, and the parts split by each stride's direction of travel against the foot (forward, then backward, then sideways; turning steps in their part and listed apart), m / m (error), (strides):\n\n{}\n|total error|: median {:.1} %, worst {:.1} % over {} courses.\n",
+        "`esangeni_course`, each course's reported distance (the foot pod's total: every stride with a length) against its geometry, and the parts split by each stride's direction of travel against the foot (forward, then backward, then sideways; turning steps in their part and listed apart), m / m (error), (strides). The last column: movements the step check refused in pairs cut where the foot never rested (the first with a rest before it only, the second, straight after, with a rest after it only), one movement of the foot split at a zero-velocity instant the rest test does not confirm; both halves count nowhere, and the metres are what their own integrations moved the foot:\n\n{}\n|total error|: median {:.1} %, worst {:.1} % over {} courses.\n",
         t.render(),
         median(&abs),
         abs.iter().copied().fold(0.0, f64::max),
@@ -288,6 +308,35 @@ pub fn report(root: &Path) -> Result<String> {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn refused_halves_are_pairs_cut_where_the_foot_never_rested() {
+        let m = |start_s: f64, end_s: f64, rest: (bool, bool), horizontal_m: f64| RejectedReport {
+            start_s,
+            end_s,
+            movement_s: (start_s, end_s),
+            reason: "no_rest",
+            swing_deg: 30,
+            swing_peak_rad_s: 3.0,
+            rest_before: rest.0,
+            rest_after: rest.1,
+            horizontal_m,
+            climb_m: 0.0,
+            lift_m: 0.0,
+        };
+        let (t, f) = (true, false);
+        let movements = [
+            m(1.0, 2.0, (t, f), 0.5),
+            m(2.0, 3.0, (f, t), 0.25), // the pair: 0.75 m
+            m(3.0, 4.0, (t, f), 1.0),
+            m(4.5, 5.0, (f, t), 1.0), // not straight after: a moment between
+            m(5.0, 6.0, (t, t), 1.0), // rested at the cut
+            m(6.0, 7.0, (f, f), 1.0), // pedalling: no rest either side
+            m(7.0, 8.0, (f, t), 1.0),
+        ];
+        assert_eq!(split_refused(&movements), (1, 0.75));
+        assert_eq!(split_refused(&movements[..1]), (0, 0.0));
+    }
 
     #[test]
     fn parts_follow_the_direction_of_travel_in_runs() {
