@@ -362,6 +362,29 @@ struct Start {
     first: Option<RawSample>,
 }
 
+impl Start {
+    /// The start of `of` at an instant whose stance's gravity is `mean` (counts·2⁸), with the
+    /// rate `omega` there, the calibration's bias and gravity; `None` where no integrator can
+    /// start: a zero `mean` (nothing to level the attitude by, [`QuatQ30::level_from_up`]) or
+    /// a gravity that is not positive ([`ZuptIntegrator::start_at`]).
+    fn at(
+        of: Starting,
+        mean: [i64; 3],
+        omega: [i32; 3],
+        cal: &Calibration,
+        gravity_q8: i64,
+    ) -> Option<Start> {
+        (mean != [0; 3] && gravity_q8 > 0).then_some(Start {
+            of,
+            mean,
+            omega,
+            gyro_bias: cal.gyro_bias,
+            gravity_q8,
+            first: None,
+        })
+    }
+}
+
 /// The every-pace stance detector and its strides, keeping at most `M` samples of a
 /// movement.
 #[derive(Clone, Debug)]
@@ -558,7 +581,7 @@ impl<const M: usize> CycleDetector<M> {
             },
             Starting::Next => &mut self.next,
         };
-        // `mean` is not zero and the gravity positive (checked when deferred): both succeed.
+        // `mean` is not zero and the gravity positive (`Start::at`): both succeed.
         *it = self.cfg.integrator;
         if let Some(level) = QuatQ30::level_from_up(p.mean) {
             let unit_q8 = self.cfg.integrator.unit_q8_for(p.gravity_q8);
@@ -844,10 +867,9 @@ impl<const M: usize> CycleDetector<M> {
         cal: &Calibration,
         gravity_q8: i64,
     ) {
-        // The gravity levels the attitude unless it is zero (`QuatQ30::level_from_up`).
-        if mean == [0; 3] || gravity_q8 <= 0 {
+        let Some(start) = Start::at(Starting::Next, mean, omega, cal, gravity_q8) else {
             return;
-        }
+        };
         // Where the stride's movement ends in the buffer: at this low stretch's start. A
         // candidate that replaces one after the energy rose (a slow swing's dip) keeps the
         // samples stored since that one's "heel-off" after the movement so far.
@@ -896,14 +918,7 @@ impl<const M: usize> CycleDetector<M> {
         // The next stride's integrator, started in place (an integrator is ≈ 300 B and the
         // M0's stack is small) once the instant outlives the next sample; at once for the
         // first stance, whose stride starts from it as it is.
-        self.defer(Start {
-            of: Starting::Next,
-            mean,
-            omega,
-            gyro_bias: cal.gyro_bias,
-            gravity_q8,
-            first: None,
-        });
+        self.defer(start);
         if self.cur.is_none() {
             self.settle();
         }
@@ -948,10 +963,9 @@ impl<const M: usize> CycleDetector<M> {
         from_rest: bool,
     ) {
         let mean = self.low_sum.map(|v| (v << 8) / self.low_n.max(1) as i64);
-        // The gravity levels the attitude unless it is zero (`QuatQ30::level_from_up`).
-        if mean == [0; 3] || gravity_q8 <= 0 {
+        let Some(start) = Start::at(Starting::Current, mean, omega, cal, gravity_q8) else {
             return;
-        }
+        };
         // In place; its integrator starts once the instant outlives the next sample (at
         // rest it moves on with every sample).
         let Some(c) = self.cur.as_mut() else {
@@ -962,14 +976,7 @@ impl<const M: usize> CycleDetector<M> {
         c.heel_off = None;
         c.flags = if from_rest { StrideFlags::FROM_REST } else { 0 };
         c.broken = None;
-        self.defer(Start {
-            of: Starting::Current,
-            mean,
-            omega,
-            gyro_bias: cal.gyro_bias,
-            gravity_q8,
-            first: None,
-        });
+        self.defer(start);
         self.movement.clear();
         self.mv_gap = None;
         self.peak = t;
