@@ -20,7 +20,8 @@
 //!   [`crate::detect::foot_frame::FootFrame::level_rates`]) inside the stride: at least
 //!   [`SWING_MIN_DEG`], turning at least [`SWING_MIN_MRADPS`] at its fastest (a foot drifting on
 //!   a seat turns slower). A shuffle slides the foot a step's length ([`STEP_MIN_MM`]) on the
-//!   level ([`LEVEL_MAX_MM`]) turning it less ([`SHUFFLE_SWING_MIN_DEG`]); a turn on the spot
+//!   level ([`LEVEL_MAX_MM`]) turning it less ([`SHUFFLE_SWING_MIN_DEG`]) and slower
+//!   ([`SHUFFLE_MIN_MRADPS`]: the length it slid is the evidence); a turn on the spot
 //!   turns it about the vertical ([`TURN_STEP_MIN_DEG`]); a slow high step raises it
 //!   ([`LIFT_STEP_MIN_MM`]) whatever it turns.
 //! - **A running foot has no rest, but a runner's swing.** At a run the foot is never still
@@ -83,6 +84,13 @@ pub const RUN_START_SWING_MRADPS: u32 = 3500;
 pub const STEP_MIN_MM: u32 = 200;
 /// …turning it by at least this, degrees…
 pub const SHUFFLE_SWING_MIN_DEG: u32 = 10;
+/// …at least this fast at its fastest, mrad/s. A sliding foot is not carried by its turn
+/// (the step's length it moved is the evidence), so [`SWING_MIN_MRADPS`] does not bound it:
+/// `pyshoe_vicon`'s slowest shuffles slide 0.37–0.49 m turning at 0.81–0.98 rad/s at their
+/// fastest. The turn need only be one: faster than the band the ledger tells a rotation from
+/// the gyro's noise and bias by (0.5 rad/s, [`StepLedger`]); a pedal crept round by a resting
+/// foot turns slower (0.38 rad/s on `hugadb_daily`).
+pub const SHUFFLE_MIN_MRADPS: u32 = 500;
 /// …and ending at most this far above or below where it started, mm (a pedal or a seated
 /// wearer's raised foot moves in an arc).
 pub const LEVEL_MAX_MM: u32 = 100;
@@ -292,12 +300,18 @@ impl StepEvidence {
                 Err(Rejection::NoRest)
             };
         }
-        // A rotation slower than a swing is the foot drifting, not stepping.
+        // A shuffle: the foot slid a step's length, turning, and stayed on the level.
+        let shuffle = swing >= SHUFFLE_SWING_MIN_DEG
+            && self.swing_peak_mradps >= SHUFFLE_MIN_MRADPS
+            && level_step;
+        // Otherwise a rotation slower than a swing is the foot drifting, not stepping.
         if self.swing_peak_mradps < SWING_MIN_MRADPS {
-            return Err(Rejection::NoSwing);
+            return if shuffle {
+                Ok(())
+            } else {
+                Err(Rejection::NoSwing)
+            };
         }
-        // A shuffle: the foot slid a step's length and stayed on the level.
-        let shuffle = swing >= SHUFFLE_SWING_MIN_DEG && level_step;
         // A turn on the spot: the foot lifted (the rate above) and turned about the
         // vertical, where a swing is small.
         let turn = path.turn_cdeg.unsigned_abs() as u32 >= TURN_STEP_MIN_DEG * 100;
@@ -823,13 +837,33 @@ mod tests {
             shuffle.judge(path(STEP_MIN_MM, LEVEL_MAX_MM as i32 + 1)),
             Err(Rejection::NoSwing)
         );
-        // A slow drift is no swing, however far it turns.
+        // A slow shuffle slides as far, turning slower than a swing; a pedal crept round
+        // turns slower still.
+        let slow_shuffle = StepEvidence {
+            swing_peak_mradps: SHUFFLE_MIN_MRADPS,
+            ..shuffle
+        };
+        assert_eq!(slow_shuffle.judge(path(STEP_MIN_MM, 20)), Ok(()));
+        assert_eq!(
+            slow_shuffle.judge(path(STEP_MIN_MM - 1, 20)),
+            Err(Rejection::NoSwing)
+        );
+        let creep = StepEvidence {
+            swing_peak_mradps: SHUFFLE_MIN_MRADPS - 1,
+            ..shuffle
+        };
+        assert_eq!(creep.judge(path(600, 20)), Err(Rejection::NoSwing));
+        // A slow drift is no swing, however far it turns, unless it slid a step's length.
         let drift = StepEvidence {
             swing_deg: 40,
             swing_peak_mradps: SWING_MIN_MRADPS - 1,
             ..e
         };
-        assert_eq!(drift.judge(path(1000, 0)), Err(Rejection::NoSwing));
+        assert_eq!(
+            drift.judge(path(STEP_MIN_MM - 1, 0)),
+            Err(Rejection::NoSwing)
+        );
+        assert_eq!(drift.judge(path(1000, 200)), Err(Rejection::NoSwing));
         // A turn on the spot: the foot lifted and turned about the vertical.
         let pivot = Path {
             turn_cdeg: -(TURN_STEP_MIN_DEG as i16) * 100,
