@@ -429,6 +429,7 @@ impl<D: StepDetector> Pipeline<D> {
             }
         }
         let filtered = self.filter.process(s.accel);
+        let mut decision = None;
         if let Some(rest) = self.rest.process(filtered, s.gyro) {
             self.at_rest = rest;
             if self.since_reset > self.rest_delay {
@@ -436,6 +437,7 @@ impl<D: StepDetector> Pipeline<D> {
                 let raw = self.lines.raw(at);
                 self.frame.process(&raw, rest);
                 self.note_motion(at, rest, &raw);
+                decision = Some((at, rest));
             }
         }
         let Some(frame) = self.frame.frame() else {
@@ -453,6 +455,8 @@ impl<D: StepDetector> Pipeline<D> {
             lines: &self.lines,
             frame: &self.frame,
             accel_lsb_per_g: self.accel_lsb_per_g,
+            rest: decision,
+            steps: &self.ledger,
         };
         self.detector.process(&input, out);
     }

@@ -27,6 +27,17 @@
 //! rest, and a stance that lasts [`MAX_STANCE_IN_STRIDE_MS`] ends the stride before it (the last step
 //! before standing).
 //!
+//! **Not where the foot cannot have landed.** Inside a walk (the stride starts where a step
+//! that counted landed), a candidate is passed over when the step check
+//! ([`crate::detect::step_check`]) would surely refuse the stride ending there: the rest test
+//! found no rest from the stride's heel-off to [`step_check::REST_NEAR_MS`] after the
+//! candidate (nor before the next heel-off), and the foot swung slower than a run starts
+//! ([`step_check::RUN_START_SWING_MRADPS`]) or less than a step ([`step_check::SWING_MIN_DEG`]).
+//! A slow stride whose swing dips, or a crawl's drag, was cut there into two halves that
+//! both counted nowhere; passed over, the stride goes on to the next stance instant and is
+//! judged whole. The candidate ends the stride after all if the stride would outlast a step
+//! ([`step_check::STEP_MAX_MS`]).
+//!
 //! **The stride.** A strapdown integrator ([`ZuptIntegrator`]) starts at each candidate:
 //! levelled from the mean specific force of the stance so far (the stretch where the energy
 //! lies the prominence below the swing), gyro bias and gravity from the last rest, and the
@@ -53,6 +64,7 @@ use crate::detect::phase_stats::{StrideStats, CHANNELS};
 use crate::detect::phases::{self, PhaseMethod};
 use crate::detect::seam::MAX_STANCE_IN_STRIDE_MS;
 use crate::detect::seam::{DetectConfig, Drain, Input, StepDetector};
+use crate::detect::step_check::{self, StepLedger};
 use crate::detect::zupt::{RollingContact, ZuptIntegrator};
 use crate::fixed::{isqrt_u64, QuatQ30};
 use crate::record::stride::{Stride, StrideEvents, StrideFlags};
@@ -156,6 +168,10 @@ pub struct CycleConfig {
     swing_min: i16,
     /// [`STANCE_RATE_MAX_MRADPS`] in gyro counts, squared.
     stance_rate_max_sq: i64,
+    /// Samples of [`step_check::REST_NEAR_MS`].
+    rest_near: u32,
+    /// Samples of [`step_check::STEP_MAX_MS`].
+    step_max: u32,
 }
 
 impl CycleConfig {
@@ -210,6 +226,8 @@ impl CycleConfig {
                 let c = gyro.counts_of_mrad_per_s(STANCE_RATE_MAX_MRADPS) as i64;
                 c * c
             },
+            rest_near: rate.samples_in_ms(step_check::REST_NEAR_MS),
+            step_max: rate.samples_in_ms(step_check::STEP_MAX_MS),
             swing_min: {
                 let c = gyro.counts_of_mrad_per_s(gyro_events::SWING_MIN_MRADPS);
                 if c > i16::MAX as u32 {
@@ -314,6 +332,16 @@ struct Candidate {
     /// sample and its position in that stride's movement buffer).
     confirm_now: bool,
     next_broken: Option<(u32, usize)>,
+    /// The rest test found the foot at rest, in a run that began after the stride's heel-off,
+    /// somewhere up to [`step_check::REST_NEAR_MS`] after the candidate or to the next
+    /// heel-off, whichever is later: where the step check looks for the stride's landing and
+    /// the next one's start.
+    rest_seen: bool,
+    /// The stride's heel-off (its start before one): where a rest counts for `rest_seen`.
+    rest_from: u32,
+    /// Not a stance: no rest near it and no swing that lands without one (see
+    /// [`CycleDetector::is_a_landing`]); only a later candidate replaces it.
+    no_landing: bool,
 }
 
 /// The stride in progress: from a confirmed stance instant.
@@ -438,6 +466,12 @@ pub struct CycleDetector<const M: usize> {
     axis_known: bool,
     /// The duration of the last stride closed, samples (0 before one): the walker's cadence.
     last_cycle: u32,
+    /// The newest sample the rest test judged (none before its first decision:
+    /// [`CycleDetector::note_rest`]), whether it was at rest, and where the newest run of
+    /// rest began (none before one).
+    rest_judged: Option<u32>,
+    rest_prev: bool,
+    rest_run_from: Option<u32>,
 }
 
 /// The window sum's threshold for a per-sample energy in Q16.
@@ -506,6 +540,9 @@ impl<const M: usize> CycleDetector<M> {
             dropped: 0,
             axis_known: false,
             last_cycle: 0,
+            rest_judged: None,
+            rest_prev: false,
+            rest_run_from: None,
         }
     }
 
@@ -615,6 +652,8 @@ impl<const M: usize> CycleDetector<M> {
         };
         self.seen = 0;
         self.sum = 0;
+        // The rest test starts again after the hole: its next rest is a new run.
+        self.rest_prev = false;
         if !keep {
             let hole = (hole_at, self.movement.len());
             if let Some(c) = self.cur.as_mut() {
@@ -634,7 +673,9 @@ impl<const M: usize> CycleDetector<M> {
     /// Feeds the newest input `newest` (its energy enters the window) and the sample the
     /// decision is about, [`CycleDetector::delay`] inputs back: its number `at`, raw values,
     /// mean-filtered foot-frame acceleration `[forward, left, up − g]` (g/2048) and origin.
-    /// The stride it lets the detector report goes into `out` (if `out` is free).
+    /// The stride it lets the detector report goes into `out` (if `out` is free). `steps`,
+    /// the step check's ledger of the same samples where a pipeline keeps one, lets the
+    /// detector pass over an instant where the foot cannot have landed (see the module).
     #[allow(clippy::too_many_arguments)]
     pub fn process_into(
         &mut self,
@@ -644,6 +685,7 @@ impl<const M: usize> CycleDetector<M> {
         foot: FootAccel,
         origin: Origin,
         cal: &Calibration,
+        steps: Option<&StepLedger>,
         out: &mut Option<Stride>,
     ) {
         if self.cand.as_ref().is_some_and(|c| c.confirm_now) {
@@ -665,7 +707,7 @@ impl<const M: usize> CycleDetector<M> {
         if self.seen < w {
             return;
         }
-        self.decide(at, self.sum, s, foot, origin, cal, out);
+        self.decide(at, self.sum, s, foot, origin, cal, steps, out);
     }
 
     #[allow(clippy::too_many_arguments)]
@@ -677,6 +719,7 @@ impl<const M: usize> CycleDetector<M> {
         foot: FootAccel,
         origin: Origin,
         cal: &Calibration,
+        steps: Option<&StepLedger>,
         out: &mut Option<Stride>,
     ) {
         self.last_at = i;
@@ -781,13 +824,30 @@ impl<const M: usize> CycleDetector<M> {
         };
 
         // Confirmation of the candidate.
+        let (start, moved_from) = self
+            .cur
+            .as_ref()
+            .map_or((i, i), |c| (c.start, c.heel_off.unwrap_or(c.start)));
+        let step_max = self.cfg.step_max;
         if let Some(c) = self.cand.as_mut() {
             if t * pd >= c.energy.max(1) * pn {
                 c.risen = true;
             }
             let waited = i.wrapping_sub(c.index) >= confirm_after;
             let rest_long = self.in_low && low_len > max_stance;
-            if (c.risen && waited) || rest_long {
+            if c.risen && waited && !rest_long && !c.no_landing {
+                c.no_landing = !Self::is_a_landing(
+                    (c.index, c.rest_seen),
+                    start,
+                    self.rest_judged,
+                    &self.cfg,
+                    steps,
+                );
+            }
+            // Passed over, the stride would be longer than a step (the step check's
+            // `STEP_MAX_MS`): the instant ends it after all, as it would have.
+            let too_long = c.no_landing && i.wrapping_sub(moved_from) > step_max;
+            if (c.risen && waited && !c.no_landing) || rest_long || too_long {
                 c.long_stance |= rest_long;
                 self.confirm(out);
                 // The next stride starts at the candidate; the swing since it counts.
@@ -844,6 +904,7 @@ impl<const M: usize> CycleDetector<M> {
         let deep = self.peak >= swing_min || (first && t <= rest);
         let better = match self.cand.as_ref() {
             None => deep,
+            Some(c) if c.no_landing => deep,
             Some(c) if c.risen => t * sn <= c.energy * sd,
             Some(c) => t < c.energy || (t <= rest && c.energy <= rest),
         };
@@ -926,6 +987,15 @@ impl<const M: usize> CycleDetector<M> {
         // replaces another extends the stride over the samples after that one).
         let flags = self.cur.as_ref().map_or(0, |c| c.flags)
             | self.cand.as_ref().map_or(0, |c| c.flags | c.next_flags);
+        // A rest counts for the stride ending here from its heel-off on.
+        let rest_from = self
+            .cur
+            .as_ref()
+            .map_or(i, |c| c.heel_off.unwrap_or(c.start));
+        let rest_seen = self.cur.is_none()
+            || self
+                .rest_run_from
+                .is_some_and(|r| r.wrapping_sub(rest_from) < u32::MAX / 2);
         self.peak_since_cand = t;
         self.cand = Some(Candidate {
             index: i,
@@ -947,7 +1017,77 @@ impl<const M: usize> CycleDetector<M> {
             long_stance: false,
             confirm_now: false,
             next_broken: None,
+            rest_seen,
+            rest_from,
+            no_landing: false,
         });
+    }
+
+    /// The rest test's decision on sample `at`, from a pipeline that runs it
+    /// ([`Input::rest`]). Without any, every candidate can be confirmed.
+    pub fn note_rest(&mut self, at: u32, rest: bool) {
+        self.rest_judged = Some(at);
+        let began = rest && !self.rest_prev;
+        self.rest_prev = rest;
+        if !rest {
+            return;
+        }
+        if began {
+            self.rest_run_from = Some(at);
+        }
+        let Some(from) = self.rest_run_from else {
+            return;
+        };
+        let near = self.cfg.rest_near;
+        if let Some(c) = self.cand.as_mut() {
+            let after = |a: u32, b: u32| a.wrapping_sub(b).wrapping_sub(1) < u32::MAX / 2;
+            // The stride's landing (from its heel-off to `REST_NEAR_MS` after the
+            // candidate) or the next stride's start (up to its heel-off, while unknown).
+            let late = after(at, c.index.wrapping_add(near))
+                && c.next_heel_off.is_some_and(|h| after(at, h));
+            // A rest that began before the heel-off is the stance the stride left (the rest
+            // test still finds it for a moment after the energy rose), not its landing.
+            c.rest_seen |= !after(c.rest_from, from) && !late;
+        }
+    }
+
+    /// Whether the foot can have landed at the candidate `index` of the stride from `start`
+    /// (`rest_seen`: [`Candidate::rest_seen`]): the step check
+    /// ([`step_check::StepEvidence::judge`]) refuses a stride with no rest within
+    /// [`step_check::REST_NEAR_MS`] after its heel-strike, unless its swing turned the foot
+    /// as fast as a run's ([`step_check::RUN_START_SWING_MRADPS`] at least). Ending a stride
+    /// at such an instant loses both halves of the movement it cuts (a slow stride whose
+    /// swing dips, a crawl); not ending it there, the stride goes on to the next stance and
+    /// is judged whole. Only where the rest test has judged every sample up to
+    /// `REST_NEAR_MS` after the candidate (`judged`, the newest it judged), found no rest
+    /// that began after the stride's heel-off, up to there or to the next heel-off, and the
+    /// foot never
+    /// turned at a run's rate (|ω|, which bounds the step check's swing from above), is the
+    /// answer no: a landing the step check might take is never refused here, and a next
+    /// stride that starts from a rest is never merged.
+    fn is_a_landing(
+        (index, rest_seen): (u32, bool),
+        start: u32,
+        judged: Option<u32>,
+        cfg: &CycleConfig,
+        steps: Option<&StepLedger>,
+    ) -> bool {
+        let Some(steps) = steps else {
+            return true;
+        };
+        // Only inside a walk: a stride that did not start where a step that counted landed
+        // (the first out of standing, or a pedal's pause after pedalling) ends where the
+        // detector says. Merged, a pedal stroke's pieces between two pauses pass for a step.
+        if !steps.landed_at(start) {
+            return true;
+        }
+        let covered = judged
+            .is_some_and(|j| j.wrapping_sub(index.wrapping_add(cfg.rest_near)) < u32::MAX / 2);
+        // The stride's swing, as the step check will measure it.
+        let (swing_deg, peak_mradps) = steps.swing(start, index.wrapping_add(1));
+        let runs = swing_deg >= step_check::SWING_MIN_DEG
+            && peak_mradps >= step_check::RUN_START_SWING_MRADPS;
+        !covered || rest_seen || runs
     }
 
     /// The stance instant moves to `i` (at rest, nothing under way); `from_rest` when the
@@ -1251,6 +1391,9 @@ impl<const M: usize> StepDetector for CycleDetector<M> {
         if out.is_none() {
             *out = self.held.take();
         }
+        if let Some((at, rest)) = x.rest {
+            self.note_rest(at, rest);
+        }
         if x.since_reset <= self.cfg.half + x.filter_delay {
             return;
         }
@@ -1272,13 +1415,23 @@ impl<const M: usize> StepDetector for CycleDetector<M> {
                 foot,
                 x.lines.origin(at),
                 &cal,
+                Some(x.steps),
                 &mut later,
             );
             if let Some(s) = later {
                 self.hold(s);
             }
         } else {
-            self.process_into(x.newest, at, &raw, foot, x.lines.origin(at), &cal, out);
+            self.process_into(
+                x.newest,
+                at,
+                &raw,
+                foot,
+                x.lines.origin(at),
+                &cal,
+                Some(x.steps),
+                out,
+            );
         }
     }
 
@@ -1398,6 +1551,7 @@ mod tests {
                 foot,
                 Origin::Measured,
                 &cal,
+                None,
                 &mut out,
             );
             strides.extend(out);
@@ -1406,6 +1560,71 @@ mod tests {
         d.finish(&mut out);
         strides.extend(out);
         (strides, d.starts_made)
+    }
+
+    #[test]
+    fn an_instant_the_step_check_would_refuse_is_passed_over_only_then() {
+        use crate::detect::step_check::{Rate, StepEvidence, StepLedger};
+        use crate::record::stride::StrideEvents;
+        let rate = SampleRate::from_hz(100).unwrap();
+        let gyro = GyroScale::from_lsb_per_dps_x10(164);
+        let cfg = CycleConfig::new(
+            rate,
+            AccelScale::from_lsb_per_g(LSB_PER_G as u32),
+            gyro,
+            Rails::FULL_SCALE,
+            PhaseMethod::Augmented,
+            SENSOR_HEIGHT_UM,
+        );
+        // 1 s at rest, where a step that counted landed at 90 (`walking`) or none did; then a
+        // slow swing about the pitch axis (0.4 s at `dps` °/s: a lobe of 0.4·dps degrees),
+        // then the foot turning back without a rest. The stride from 90 has its candidate
+        // at 150.
+        let landing = |dps: f64, walking: bool, rest_seen: bool, judged: u32| {
+            let mut l = StepLedger::new(rate, gyro);
+            for i in 0..100 {
+                l.process(i, true, Rate::Level([0, 0]));
+            }
+            if walking {
+                let before = Stride {
+                    events: StrideEvents {
+                        end: 90,
+                        ..StrideEvents::default()
+                    },
+                    ..Stride::default()
+                };
+                let landed = StepEvidence {
+                    rest_after: true,
+                    ..StepEvidence::default()
+                };
+                l.judged(&before, &landed, Ok(()));
+            }
+            for i in 100..140 {
+                l.process(i, false, Rate::Level([(dps * 16.4) as i32, 0]));
+            }
+            for i in 140..250 {
+                l.process(i, false, Rate::Level([-(10.0 * 16.4) as i32, 0]));
+            }
+            CycleDetector::<16>::is_a_landing((150, rest_seen), 90, Some(judged), &cfg, Some(&l))
+        };
+        // 150 °/s (2.6 rad/s) for 60°, slower than a run starts, and no rest after its
+        // heel-off up to 0.3 s after the candidate: the step check refuses it for sure.
+        assert!(!landing(150.0, true, false, 180));
+        // A rest after its heel-off, or not yet judged 0.3 s on: it may be a landing.
+        assert!(landing(150.0, true, true, 180));
+        assert!(landing(150.0, true, false, 179));
+        // A swing at a run's rate (250 °/s, 4.4 rad/s, over 25°) lands without a rest.
+        assert!(landing(250.0, true, false, 180));
+        // Outside a walk (no step landed where the stride starts) the detector decides; so
+        // it does without a ledger.
+        assert!(landing(150.0, false, false, 180));
+        assert!(CycleDetector::<16>::is_a_landing(
+            (150, false),
+            90,
+            Some(200),
+            &cfg,
+            None
+        ));
     }
 
     #[test]

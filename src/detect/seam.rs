@@ -14,6 +14,7 @@ use crate::detect::foot_frame::FootFrameEstimator;
 use crate::detect::phase_stats::StrideStats;
 use crate::detect::phases::PhaseMethod;
 use crate::detect::stance::StanceLimits;
+use crate::detect::step_check::StepLedger;
 use crate::detect::zupt::GravityReading;
 use crate::record::stride::{StepAmplitude, Stride};
 use crate::sensor::rate::SampleRate;
@@ -189,6 +190,12 @@ pub struct Input<'a> {
     pub frame: &'a FootFrameEstimator,
     /// Accelerometer counts per g.
     pub accel_lsb_per_g: i32,
+    /// The rest test's decision this input brought, and the sample it is about
+    /// ([`crate::detect::rest`]; none until its window has filled).
+    pub rest: Option<(u32, bool)>,
+    /// The step check's ledger of the samples so far (the rest decisions and rotations up
+    /// to the one in [`Input::rest`]).
+    pub steps: &'a StepLedger,
 }
 
 /// What a detector is given when the samples stop: at a hole too long to interpolate, and at

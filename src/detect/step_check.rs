@@ -557,7 +557,42 @@ impl StepLedger {
         // The stride's whole span: a detector's movement (heel-off to foot-flat) holds the
         // swing, and one whose events are not stance instants (Lu's peak and valley) has it
         // between them.
-        let (mv_first, mv_end) = (e.start, e.end.wrapping_add(1));
+        let (swing_deg, swing_peak_mradps) = self.swing(e.start, e.end.wrapping_add(1));
+        let before = (e.start.wrapping_sub(self.near), e.heel_off.wrapping_add(1));
+        let after = (e.heel_strike, e.end.wrapping_add(self.near).wrapping_add(1));
+        // A stride starts from the ground where the step before it landed.
+        let (mut rest_before, mut rest_after) = (self.landed == Some(e.start), false);
+        for r in self.rests.iter().take((self.rests_n as usize).min(RESTS)) {
+            rest_before |= Self::overlap(r.first, r.end, before.0, before.1);
+            rest_after |= Self::overlap(r.first, r.end, after.0, after.1);
+        }
+        // What the foot did since its last step (or since the last movement refused for
+        // want of a stance, so that a walk out of pedalling loses one stride, not all).
+        let last = self.last_end.unwrap_or(0);
+        let from = match self.unsettled_from {
+            Some(r) if Self::before(last, r) => r,
+            _ => last,
+        };
+        let since = self.split(from, e.start);
+        StepEvidence {
+            swing_deg,
+            swing_peak_mradps,
+            rest_before,
+            rest_after,
+            short_enough: e.foot_flat.wrapping_sub(e.heel_off) <= self.step_max,
+            settled: since.moving_ms <= UNSETTLED_MS || since.still_ms >= STANCE_MIN_MS,
+        }
+    }
+
+    /// Whether the last step that counted landed at sample `start`.
+    pub fn landed_at(&self, start: u32) -> bool {
+        self.landed == Some(start)
+    }
+
+    /// The swing of samples `[mv_first, mv_end)`: the largest one-way rotation about a level
+    /// axis that was fastest among them, degrees, and that fastest rate, mrad/s
+    /// ([`StepEvidence::swing_deg`], [`StepEvidence::swing_peak_mradps`]).
+    pub fn swing(&self, mv_first: u32, mv_end: u32) -> (u32, u32) {
         // Sizes in 1/16 °: the kept rotations' own, and the two in progress converted.
         let (mut largest, mut peak) = (0u32, 0u16);
         let stored = (self.lobes_n as usize).min(LOBES);
@@ -574,33 +609,10 @@ impl StepLedger {
                 (largest, peak) = (l.area_q4 as u32, l.peak);
             }
         }
-        let before = (e.start.wrapping_sub(self.near), e.heel_off.wrapping_add(1));
-        let after = (e.heel_strike, e.end.wrapping_add(self.near).wrapping_add(1));
-        // A stride starts from the ground where the step before it landed.
-        let (mut rest_before, mut rest_after) = (self.landed == Some(e.start), false);
-        for r in self.rests.iter().take((self.rests_n as usize).min(RESTS)) {
-            rest_before |= Self::overlap(r.first, r.end, before.0, before.1);
-            rest_after |= Self::overlap(r.first, r.end, after.0, after.1);
-        }
         // counts → mrad/s: · (dps/lsb) °/s · (π/180) · 1000 = · 17.4533·dps/lsb.
         let peak_mradps = (peak as u64 * 174_533 * self.gyro.dps() as u64
             / (self.gyro.lsb() as u64 * 10_000)) as u32;
-        // What the foot did since its last step (or since the last movement refused for
-        // want of a stance, so that a walk out of pedalling loses one stride, not all).
-        let last = self.last_end.unwrap_or(0);
-        let from = match self.unsettled_from {
-            Some(r) if Self::before(last, r) => r,
-            _ => last,
-        };
-        let since = self.split(from, e.start);
-        StepEvidence {
-            swing_deg: largest / 16,
-            swing_peak_mradps: peak_mradps,
-            rest_before,
-            rest_after,
-            short_enough: e.foot_flat.wrapping_sub(e.heel_off) <= self.step_max,
-            settled: since.moving_ms <= UNSETTLED_MS || since.still_ms >= STANCE_MIN_MS,
-        }
+        (largest / 16, peak_mradps)
     }
 
     /// The verdict on the stride `s` whose evidence was `evidence`: where a step that counted
