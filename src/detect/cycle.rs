@@ -1405,33 +1405,21 @@ impl<const M: usize> StepDetector for CycleDetector<M> {
         let Some(cal) = Calibration::of(x.frame, x.accel_lsb_per_g) else {
             return;
         };
-        if out.is_some() {
-            // Reported at the next call: this one has its stride.
-            let mut later = None;
-            self.process_into(
-                x.newest,
-                at,
-                &raw,
-                foot,
-                x.lines.origin(at),
-                &cal,
-                Some(x.steps),
-                &mut later,
-            );
-            if let Some(s) = later {
-                self.hold(s);
-            }
-        } else {
-            self.process_into(
-                x.newest,
-                at,
-                &raw,
-                foot,
-                x.lines.origin(at),
-                &cal,
-                Some(x.steps),
-                out,
-            );
+        // With `out` taken, a stride released now is reported at the next call.
+        let mut later = None;
+        let into = if out.is_some() { &mut later } else { out };
+        self.process_into(
+            x.newest,
+            at,
+            &raw,
+            foot,
+            x.lines.origin(at),
+            &cal,
+            Some(x.steps),
+            into,
+        );
+        if let Some(s) = later {
+            self.hold(s);
         }
     }
 
