@@ -585,8 +585,14 @@ fn refine_period<I: Iterator<Item = f64>>(stamps: &impl Fn() -> I, n: usize, nom
 fn find_holes(stamps: impl Iterator<Item = f64>, period: f64, offset: f64) -> Vec<Gap> {
     // u_j = t_j − offset − j·P: a row's lag behind the clock before any hole is counted; the
     // least of u over [i, i + LOOK_AHEAD), by a monotone deque over a window of as many rows.
-    let mut window: std::collections::VecDeque<f64> = std::collections::VecDeque::new();
-    let mut deque: std::collections::VecDeque<(usize, f64)> = std::collections::VecDeque::new();
+    // Both are rings of LOOK_AHEAD slots (the window holds at most that many rows, the deque
+    // at most the window's), indexed modulo a power of two: a fixed array, not a `VecDeque`.
+    const _: () = assert!(LOOK_AHEAD.is_power_of_two());
+    let slot = |k: usize| k % LOOK_AHEAD;
+    // The window's lags by row; the deque's (row, lag) from `head`, `len` of them.
+    let mut window = [0.0f64; LOOK_AHEAD];
+    let mut deque = [(0usize, 0.0f64); LOOK_AHEAD];
+    let (mut head, mut len) = (0usize, 0usize);
     let mut holes: Vec<Gap> = Vec::new();
     let mut lost = 0u64;
     // Whether a row since the last hole was on time: if none was, a hole found now is the
@@ -612,29 +618,29 @@ fn find_holes(stamps: impl Iterator<Item = f64>, period: f64, offset: f64) -> Ve
         let lag = (u - lost as f64 * period) / period;
         on_time_since |= lag < 1.0 - EARLY_ALLOWANCE;
     };
-    let mut first = 0usize;
+    let (mut first, mut rows) = (0usize, 0usize);
     for (j, t) in stamps.enumerate() {
         let u = t - offset - j as f64 * period;
-        while deque.back().is_some_and(|&(_, v)| v >= u) {
-            deque.pop_back();
+        while len > 0 && deque[slot(head + len - 1)].1 >= u {
+            len -= 1;
         }
-        deque.push_back((j, u));
-        window.push_back(u);
-        if window.len() == LOOK_AHEAD {
-            judge(first, deque[0].1, window[0]);
-            window.pop_front();
-            if deque[0].0 == first {
-                deque.pop_front();
+        deque[slot(head + len)] = (j, u);
+        len += 1;
+        window[slot(j)] = u;
+        rows = j + 1;
+        if rows - first == LOOK_AHEAD {
+            judge(first, deque[head].1, window[slot(first)]);
+            if deque[head].0 == first {
+                (head, len) = (slot(head + 1), len - 1);
             }
             first += 1;
         }
     }
-    // The last rows, their windows cut by the end.
-    while let Some(u) = window.front().copied() {
-        judge(first, deque[0].1, u);
-        window.pop_front();
-        if deque[0].0 == first {
-            deque.pop_front();
+    // The last rows, their windows cut by the end (the deque holds the last row till then).
+    while first < rows {
+        judge(first, deque[head].1, window[slot(first)]);
+        if deque[head].0 == first {
+            (head, len) = (slot(head + 1), len - 1);
         }
         first += 1;
     }
