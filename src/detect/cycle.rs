@@ -31,11 +31,15 @@
 //! that counted landed), a candidate is passed over when the step check
 //! ([`crate::detect::step_check`]) would surely refuse the stride ending there: the rest test
 //! found no rest from the stride's heel-off to [`step_check::REST_NEAR_MS`] after the
-//! candidate (nor before the next heel-off), and the foot swung slower than a run starts
-//! ([`step_check::RUN_START_SWING_MRADPS`]) or less than a step ([`step_check::SWING_MIN_DEG`]).
-//! A slow stride whose swing dips, or a crawl's drag, was cut there into two halves that
-//! both counted nowhere; passed over, the stride goes on to the next stance instant and is
-//! judged whole. The candidate ends the stride after all if the stride would outlast a step
+//! candidate (nor before the next heel-off; a blip of movement inside a rest does not end it,
+//! as in the check's ledger), and either the foot swung slower than a run starts
+//! ([`step_check::RUN_START_SWING_MRADPS`]) or less than a step ([`step_check::SWING_MIN_DEG`]),
+//! or, swung as a run starts but slower than a runner's ([`step_check::RUN_SWING_MRADPS`]), the
+//! stride's own integration to the candidate did not land it on the level a step away
+//! ([`step_check::lands_a_step_away`], what the check asks of a run's first stride). A slow
+//! stride whose swing dips, a crawl's drag, or a stride out of a stand that stops short and
+//! goes on, was cut there into two halves that both counted nowhere; passed over, the stride
+//! goes on to the next stance instant and is judged whole. The candidate ends the stride after all if the stride would outlast a step
 //! ([`step_check::STEP_MAX_MS`]).
 //!
 //! **The stride.** A strapdown integrator ([`ZuptIntegrator`]) starts at each candidate:
@@ -170,6 +174,8 @@ pub struct CycleConfig {
     stance_rate_max_sq: i64,
     /// Samples of [`step_check::REST_NEAR_MS`].
     rest_near: u32,
+    /// Samples of [`step_check::REST_BLIP_MS`].
+    rest_blip: u32,
     /// Samples of [`step_check::STEP_MAX_MS`].
     step_max: u32,
 }
@@ -227,6 +233,7 @@ impl CycleConfig {
                 c * c
             },
             rest_near: rate.samples_in_ms(step_check::REST_NEAR_MS),
+            rest_blip: rate.samples_in_ms(step_check::REST_BLIP_MS),
             step_max: rate.samples_in_ms(step_check::STEP_MAX_MS),
             swing_min: {
                 let c = gyro.counts_of_mrad_per_s(gyro_events::SWING_MIN_MRADPS);
@@ -467,10 +474,10 @@ pub struct CycleDetector<const M: usize> {
     /// The duration of the last stride closed, samples (0 before one): the walker's cadence.
     last_cycle: u32,
     /// The newest sample the rest test judged (none before its first decision:
-    /// [`CycleDetector::note_rest`]), whether it was at rest, and where the newest run of
-    /// rest began (none before one).
+    /// [`CycleDetector::note_rest`]), the sample after the newest it found at rest, and
+    /// where the newest run of rest began (none before one).
     rest_judged: Option<u32>,
-    rest_prev: bool,
+    rest_end: Option<u32>,
     rest_run_from: Option<u32>,
 }
 
@@ -541,7 +548,7 @@ impl<const M: usize> CycleDetector<M> {
             axis_known: false,
             last_cycle: 0,
             rest_judged: None,
-            rest_prev: false,
+            rest_end: None,
             rest_run_from: None,
         }
     }
@@ -653,7 +660,7 @@ impl<const M: usize> CycleDetector<M> {
         self.seen = 0;
         self.sum = 0;
         // The rest test starts again after the hole: its next rest is a new run.
-        self.rest_prev = false;
+        self.rest_end = None;
         if !keep {
             let hole = (hole_at, self.movement.len());
             if let Some(c) = self.cur.as_mut() {
@@ -836,12 +843,14 @@ impl<const M: usize> CycleDetector<M> {
             let waited = i.wrapping_sub(c.index) >= confirm_after;
             let rest_long = self.in_low && low_len > max_stance;
             if c.risen && waited && !rest_long && !c.no_landing {
+                let cfg = &self.cfg;
                 c.no_landing = !Self::is_a_landing(
                     (c.index, c.rest_seen),
                     start,
                     self.rest_judged,
-                    &self.cfg,
+                    cfg,
                     steps,
+                    || Self::lands_a_step_away(c, cfg),
                 );
             }
             // Passed over, the stride would be longer than a step (the step check's
@@ -1027,12 +1036,17 @@ impl<const M: usize> CycleDetector<M> {
     /// ([`Input::rest`]). Without any, every candidate can be confirmed.
     pub fn note_rest(&mut self, at: u32, rest: bool) {
         self.rest_judged = Some(at);
-        let began = rest && !self.rest_prev;
-        self.rest_prev = rest;
         if !rest {
             return;
         }
-        if began {
+        // A blip of movement inside a rest (the test flickers on a foot that settles, or
+        // that is leaving) does not end it: the rest goes on, as the step check's ledger
+        // keeps its runs ([`step_check::REST_BLIP_MS`]).
+        let goes_on = self
+            .rest_end
+            .is_some_and(|end| at.wrapping_sub(end) <= self.cfg.rest_blip);
+        self.rest_end = Some(at.wrapping_add(1));
+        if !goes_on {
             self.rest_run_from = Some(at);
         }
         let Some(from) = self.rest_run_from else {
@@ -1051,26 +1065,44 @@ impl<const M: usize> CycleDetector<M> {
         }
     }
 
+    /// Whether the stride ending at candidate `c` came down on the level a step away, as the
+    /// step check will read it: the stride's integration to the candidate, closed as
+    /// [`CycleDetector::close`] closes it. Not inlined: its trajectory takes stack only
+    /// while it runs, not in every sample's frame (the M0's stack).
+    #[inline(never)]
+    fn lands_a_step_away(c: &Candidate, cfg: &CycleConfig) -> bool {
+        let v_end = cfg
+            .rolling
+            .velocity_q8(c.snap.attitude(), c.omega, c.snap.unit_q8());
+        let d = c
+            .snap
+            .displacement_restoring(v_end, c.gravity, &cfg.rails, cfg.restore_accel);
+        let horizontal_mm = (d.horizontal_um.min(u32::MAX as u64) as u32) / 1000;
+        step_check::lands_a_step_away(horizontal_mm, d.climb_mm())
+    }
+
     /// Whether the foot can have landed at the candidate `index` of the stride from `start`
     /// (`rest_seen`: [`Candidate::rest_seen`]): the step check
     /// ([`step_check::StepEvidence::judge`]) refuses a stride with no rest within
     /// [`step_check::REST_NEAR_MS`] after its heel-strike, unless its swing turned the foot
-    /// as fast as a run's ([`step_check::RUN_START_SWING_MRADPS`] at least). Ending a stride
-    /// at such an instant loses both halves of the movement it cuts (a slow stride whose
-    /// swing dips, a crawl); not ending it there, the stride goes on to the next stance and
-    /// is judged whole. Only where the rest test has judged every sample up to
-    /// `REST_NEAR_MS` after the candidate (`judged`, the newest it judged), found no rest
-    /// that began after the stride's heel-off, up to there or to the next heel-off, and the
-    /// foot never
-    /// turned at a run's rate (|ω|, which bounds the step check's swing from above), is the
-    /// answer no: a landing the step check might take is never refused here, and a next
-    /// stride that starts from a rest is never merged.
+    /// as fast as a runner's ([`step_check::RUN_SWING_MRADPS`]), or as fast as a run starts
+    /// ([`step_check::RUN_START_SWING_MRADPS`]) and the stride came down on the level a step
+    /// away (`lands_a_step`: the stride's integration to the candidate, as its close will
+    /// measure it; asked only then). Ending a stride at such an instant loses both halves of
+    /// the movement it cuts (a slow stride whose swing dips, a crawl); not ending it there,
+    /// the stride goes on to the next stance and is judged whole. Only where the rest test
+    /// has judged every sample up to `REST_NEAR_MS` after the candidate (`judged`, the newest
+    /// it judged), found no rest that began after the stride's heel-off, up to there or to
+    /// the next heel-off, and the step check would refuse the swing as above is the answer
+    /// no: a landing the step check might take is never refused here, and a next stride that
+    /// starts from a rest is never merged.
     fn is_a_landing(
         (index, rest_seen): (u32, bool),
         start: u32,
         judged: Option<u32>,
         cfg: &CycleConfig,
         steps: Option<&StepLedger>,
+        lands_a_step: impl FnOnce() -> bool,
     ) -> bool {
         let Some(steps) = steps else {
             return true;
@@ -1085,9 +1117,13 @@ impl<const M: usize> CycleDetector<M> {
             .is_some_and(|j| j.wrapping_sub(index.wrapping_add(cfg.rest_near)) < u32::MAX / 2);
         // The stride's swing, as the step check will measure it.
         let (swing_deg, peak_mradps) = steps.swing(start, index.wrapping_add(1));
-        let runs = swing_deg >= step_check::SWING_MIN_DEG
-            && peak_mradps >= step_check::RUN_START_SWING_MRADPS;
-        !covered || rest_seen || runs
+        let swung = swing_deg >= step_check::SWING_MIN_DEG;
+        // A runner's swing lands without a rest; a run's first stride (a rest before it
+        // only) lands if it came down on the level a step away, which only the stride's
+        // integration says (asked last: it costs a displacement).
+        let runner = swung && peak_mradps >= step_check::RUN_SWING_MRADPS;
+        let run_start = swung && peak_mradps >= step_check::RUN_START_SWING_MRADPS;
+        !covered || rest_seen || runner || (run_start && lands_a_step())
     }
 
     /// The stance instant moves to `i` (at rest, nothing under way); `from_rest` when the
@@ -1568,7 +1604,7 @@ mod tests {
         // slow swing about the pitch axis (0.4 s at `dps` °/s: a lobe of 0.4·dps degrees),
         // then the foot turning back without a rest. The stride from 90 has its candidate
         // at 150.
-        let landing = |dps: f64, walking: bool, rest_seen: bool, judged: u32| {
+        let landing = |dps: f64, walking: bool, rest_seen: bool, judged: u32, step_away: bool| {
             let mut l = StepLedger::new(rate, gyro);
             for i in 0..100 {
                 l.process(i, true, Rate::Level([0, 0]));
@@ -1593,25 +1629,39 @@ mod tests {
             for i in 140..250 {
                 l.process(i, false, Rate::Level([-(10.0 * 16.4) as i32, 0]));
             }
-            CycleDetector::<16>::is_a_landing((150, rest_seen), 90, Some(judged), &cfg, Some(&l))
+            CycleDetector::<16>::is_a_landing(
+                (150, rest_seen),
+                90,
+                Some(judged),
+                &cfg,
+                Some(&l),
+                || step_away,
+            )
         };
         // 150 °/s (2.6 rad/s) for 60°, slower than a run starts, and no rest after its
-        // heel-off up to 0.3 s after the candidate: the step check refuses it for sure.
-        assert!(!landing(150.0, true, false, 180));
+        // heel-off up to 0.3 s after the candidate: the step check refuses it for sure,
+        // wherever it came down.
+        assert!(!landing(150.0, true, false, 180, true));
         // A rest after its heel-off, or not yet judged 0.3 s on: it may be a landing.
-        assert!(landing(150.0, true, true, 180));
-        assert!(landing(150.0, true, false, 179));
-        // A swing at a run's rate (250 °/s, 4.4 rad/s, over 25°) lands without a rest.
-        assert!(landing(250.0, true, false, 180));
+        assert!(landing(150.0, true, true, 180, false));
+        assert!(landing(150.0, true, false, 179, false));
+        // A swing as fast as a run starts (250 °/s, 4.4 rad/s, over 25°) lands without a rest
+        // where it came down on the level a step away; where it came down where it left, the
+        // step check refuses it.
+        assert!(landing(250.0, true, false, 180, true));
+        assert!(!landing(250.0, true, false, 180, false));
+        // A runner's swing (300 °/s, 5.2 rad/s) lands without a rest, wherever.
+        assert!(landing(300.0, true, false, 180, false));
         // Outside a walk (no step landed where the stride starts) the detector decides; so
         // it does without a ledger.
-        assert!(landing(150.0, false, false, 180));
+        assert!(landing(150.0, false, false, 180, false));
         assert!(CycleDetector::<16>::is_a_landing(
             (150, false),
             90,
             Some(200),
             &cfg,
-            None
+            None,
+            || false,
         ));
     }
 

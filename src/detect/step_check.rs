@@ -284,7 +284,7 @@ impl StepEvidence {
         }
         let swing = self.swing_deg;
         // The foot landed on the level a step's length from where it left.
-        let level_step = horizontal_mm >= STEP_MIN_MM && climb_mm.unsigned_abs() <= LEVEL_MAX_MM;
+        let level_step = lands_a_step_away(horizontal_mm, climb_mm);
         if !(self.rest_before && self.rest_after) {
             // No rest either side: only a runner's swing is a step; a rest on one side and a
             // swing faster than pedalling onto the level a step away is a run's first or
@@ -324,6 +324,13 @@ impl StepEvidence {
             Err(Rejection::NoSwing)
         }
     }
+}
+
+/// Whether a movement of `horizontal_mm` that rose `climb_mm` landed on the level a step's
+/// length from where it left ([`STEP_MIN_MM`], [`LEVEL_MAX_MM`]): what a shuffle, and a run's
+/// first or last stride with a rest on one side only, must show.
+pub const fn lands_a_step_away(horizontal_mm: u32, climb_mm: i32) -> bool {
+    horizontal_mm >= STEP_MIN_MM && climb_mm.unsigned_abs() <= LEVEL_MAX_MM
 }
 
 /// A sample's angular rate, as the ledger measures rotations by it.

@@ -122,13 +122,17 @@ pub struct Displacement {
 }
 
 impl Displacement {
+    /// The height gained, mm (rounded, saturated): the stride's `climb_mm`.
+    pub fn climb_mm(&self) -> i32 {
+        ((self.vertical_um + 500).div_euclid(1000)).clamp(i32::MIN as i64, i32::MAX as i64) as i32
+    }
+
     /// Writes what this trajectory gives into `s`: horizontal displacement, climb, lift
     /// (rounded to mm, saturated) and the heading change `turning_angle_cdeg`.
     pub fn record_on(&self, s: &mut Stride, turning_angle_cdeg: i16) {
         let d = self;
         s.zupt_um = d.horizontal_um.min(u32::MAX as u64) as u32;
-        s.climb_mm =
-            ((d.vertical_um + 500).div_euclid(1000)).clamp(i32::MIN as i64, i32::MAX as i64) as i32;
+        s.climb_mm = d.climb_mm();
         s.max_sensor_lift_mm = ((d.max_lift_um as u64 + 500) / 1000).min(u16::MAX as u64) as u16;
         s.turning_angle_cdeg = turning_angle_cdeg;
         s.travel_cdeg = d.travel_cdeg;
