@@ -162,29 +162,30 @@ fn plateaus<I: Iterator<Item = ImuSample>>(
         })
     });
     let mut counts = [[(0usize, 0usize, 0usize, 0usize); 2]; 6];
-    if candidate.iter().flatten().any(|&c| c) {
+    // The candidate sides only, listed once (channel, side, sign, extreme, edge): the pass
+    // over the samples then tests no flag per side and sample.
+    let sides: Vec<(usize, usize, f64, f64, f64)> = (0..6)
+        .flat_map(|k| (0..2).map(move |side| (k, side)))
+        .filter(|&(k, side)| candidate[k][side])
+        .map(|(k, side)| (k, side, SIGNS[side], m[k][side], edge[k][side]))
+        .collect();
+    if !sides.is_empty() {
         for s in samples() {
             let s = &s;
-            for k in 0..6 {
-                let x = channel(s, k);
-                for (side, sign) in SIGNS.iter().enumerate() {
-                    if !candidate[k][side] {
-                        continue;
+            for &(k, side, sign, extreme, edge) in &sides {
+                let v = sign * channel(s, k);
+                let (flat_runs, longest, run, exact) = &mut counts[k][side];
+                if v >= extreme {
+                    *exact += 1;
+                }
+                if v >= edge {
+                    *run += 1;
+                    if *run == 2 {
+                        *flat_runs += 1;
                     }
-                    let v = sign * x;
-                    let (flat_runs, longest, run, exact) = &mut counts[k][side];
-                    if v >= m[k][side] {
-                        *exact += 1;
-                    }
-                    if v >= edge[k][side] {
-                        *run += 1;
-                        if *run == 2 {
-                            *flat_runs += 1;
-                        }
-                        *longest = (*longest).max(*run);
-                    } else {
-                        *run = 0;
-                    }
+                    *longest = (*longest).max(*run);
+                } else {
+                    *run = 0;
                 }
             }
         }
@@ -283,14 +284,18 @@ pub fn learn_counted_of<I: Iterator<Item = ImuSample>>(
             clipped: 0,
         });
     }
+    // Counted in a local array, not through the reports (which the loop would write back
+    // on every sample).
+    let mut clipped = [0usize; 6];
     for c in counts {
         let bits = rails.clipped_axes(&c);
         // Bits 0–2 accelerometer, 3–5 gyroscope: the same order as `AXES`.
-        for (k, a) in axes.iter_mut().enumerate() {
-            if bits & (1 << k) != 0 {
-                a.clipped += 1;
-            }
+        for (k, n) in clipped.iter_mut().enumerate() {
+            *n += usize::from(bits & (1 << k) != 0);
         }
+    }
+    for (a, n) in axes.iter_mut().zip(clipped) {
+        a.clipped = n;
     }
     RailsReport { axes, rails }
 }
