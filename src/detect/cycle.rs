@@ -69,7 +69,7 @@ use crate::detect::phases::{self, PhaseMethod};
 use crate::detect::seam::MAX_STANCE_IN_STRIDE_MS;
 use crate::detect::seam::{DetectConfig, Drain, Input, StepDetector};
 use crate::detect::step_check::{self, StepLedger};
-use crate::detect::zupt::{RollingContact, ZuptIntegrator};
+use crate::detect::zupt::{Displacement, RollingContact, ZuptIntegrator};
 use crate::fixed::{isqrt_u64, QuatQ30};
 use crate::record::stride::{Stride, StrideEvents, StrideFlags};
 use crate::sensor::rate::SampleRate;
@@ -1071,14 +1071,21 @@ impl<const M: usize> CycleDetector<M> {
     /// while it runs, not in every sample's frame (the M0's stack).
     #[inline(never)]
     fn lands_a_step_away(c: &Candidate, cfg: &CycleConfig) -> bool {
+        let d = Self::trajectory(c, cfg);
+        let horizontal_mm = (d.horizontal_um.min(u32::MAX as u64) as u32) / 1000;
+        step_check::lands_a_step_away(horizontal_mm, d.climb_mm())
+    }
+
+    /// The stride's trajectory to candidate `c`: the integrator as it was there, the
+    /// rolling contact's velocity imposed at the end, the clipped samples' loss restored.
+    /// Inlined into each caller, so that the close's frame stays as it was.
+    #[inline(always)]
+    fn trajectory(c: &Candidate, cfg: &CycleConfig) -> Displacement {
         let v_end = cfg
             .rolling
             .velocity_q8(c.snap.attitude(), c.omega, c.snap.unit_q8());
-        let d = c
-            .snap
-            .displacement_restoring(v_end, c.gravity, &cfg.rails, cfg.restore_accel);
-        let horizontal_mm = (d.horizontal_um.min(u32::MAX as u64) as u32) / 1000;
-        step_check::lands_a_step_away(horizontal_mm, d.climb_mm())
+        c.snap
+            .displacement_restoring(v_end, c.gravity, &cfg.rails, cfg.restore_accel)
     }
 
     /// Whether the foot can have landed at the candidate `index` of the stride from `start`
@@ -1303,12 +1310,7 @@ impl<const M: usize> CycleDetector<M> {
         if c.snap.turned_over_45_deg() {
             flags |= StrideFlags::TURN;
         }
-        let v_end = cfg
-            .rolling
-            .velocity_q8(c.snap.attitude(), c.omega, c.snap.unit_q8());
-        let d = c
-            .snap
-            .displacement_restoring(v_end, c.gravity, &cfg.rails, cfg.restore_accel);
+        let d = Self::trajectory(c, cfg);
         let (toe_off, heel_strike) = match (cur.heel_off, cur.broken) {
             // Events found after the hole are set to it: the buffer does not count the
             // samples lost in it, and the restart did not see them.
