@@ -39,8 +39,8 @@
 //! ([`step_check::lands_a_step_away`], what the check asks of a run's first stride). A slow
 //! stride whose swing dips, a crawl's drag, or a stride out of a stand that stops short and
 //! goes on, was cut there into two halves that both counted nowhere; passed over, the stride
-//! goes on to the next stance instant and is judged whole. The candidate ends the stride after all if the stride would outlast a step
-//! ([`step_check::STEP_MAX_MS`]).
+//! goes on to the next stance instant and is judged whole. The candidate ends the stride
+//! after all if the stride would outlast a step ([`step_check::STEP_MAX_MS`]).
 //!
 //! **The stride.** A strapdown integrator ([`ZuptIntegrator`]) starts at each candidate:
 //! levelled from the mean specific force of the stance so far (the stretch where the energy
@@ -1072,8 +1072,8 @@ impl<const M: usize> CycleDetector<M> {
     #[inline(never)]
     fn lands_a_step_away(c: &Candidate, cfg: &CycleConfig) -> bool {
         let d = Self::trajectory(c, cfg);
-        let horizontal_mm = (d.horizontal_um.min(u32::MAX as u64) as u32) / 1000;
-        step_check::lands_a_step_away(horizontal_mm, d.climb_mm())
+        // In the units the check reads of the stride ([`step_check::Path::of`]).
+        step_check::lands_a_step_away(d.zupt_um() / 1000, d.climb_mm())
     }
 
     /// The stride's trajectory to candidate `c`: the integrator as it was there, the

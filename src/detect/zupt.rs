@@ -122,6 +122,11 @@ pub struct Displacement {
 }
 
 impl Displacement {
+    /// The horizontal displacement, µm (saturated): the stride's `zupt_um`.
+    pub fn zupt_um(&self) -> u32 {
+        self.horizontal_um.min(u32::MAX as u64) as u32
+    }
+
     /// The height gained, mm (rounded, saturated): the stride's `climb_mm`.
     pub fn climb_mm(&self) -> i32 {
         ((self.vertical_um + 500).div_euclid(1000)).clamp(i32::MIN as i64, i32::MAX as i64) as i32
@@ -131,7 +136,7 @@ impl Displacement {
     /// (rounded to mm, saturated) and the heading change `turning_angle_cdeg`.
     pub fn record_on(&self, s: &mut Stride, turning_angle_cdeg: i16) {
         let d = self;
-        s.zupt_um = d.horizontal_um.min(u32::MAX as u64) as u32;
+        s.zupt_um = d.zupt_um();
         s.climb_mm = d.climb_mm();
         s.max_sensor_lift_mm = ((d.max_lift_um as u64 + 500) / 1000).min(u16::MAX as u64) as u16;
         s.turning_angle_cdeg = turning_angle_cdeg;
