@@ -17,7 +17,7 @@ use gaitclip::pipeline::config::Config;
 use gaitclip::pipeline::Pipeline;
 use gaitclip::record::stride::{Stride, StrideFlags};
 use gaitclip::sensor::sample::{AxisRails, RawSample};
-use nalgebra::{UnitQuaternion, Vector3};
+use nalgebra::{UnitQuaternion, Vector2, Vector3};
 
 use crate::io::clock::Gap;
 
@@ -145,7 +145,56 @@ pub fn travel_deg(run: &CoreRun, k: usize) -> Result<f64, Skipped> {
 
 /// The twin's horizontal ZUPT displacement of stride `k` of `run`, level frame of its start,
 /// m.
-pub fn horizontal(run: &CoreRun, k: usize) -> Result<nalgebra::Vector2<f64>, Skipped> {
+pub fn horizontal(run: &CoreRun, k: usize) -> Result<Vector2<f64>, Skipped> {
+    integration(run, k).map(|i| i.linear().xy())
+}
+
+/// Stride `k`'s strapdown integration in `f64` up to its zero-velocity update: what the core's
+/// dedrift works from, and what the corrections it does not make
+/// ([`crate::eval::constraints`]) would work from.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Integration {
+    /// The displacement at the end, level frame of the start, m: the rails' losses put back,
+    /// nothing removed.
+    pub displacement: Vector3<f64>,
+    /// The velocity left at the end less what the rolling contact imposes there (the
+    /// zero-velocity residual), m/s.
+    pub residual: Vector3<f64>,
+    /// The tilt the gyro's rails lost, put back as the gravity it leaked (the core's
+    /// correction, zero without a clipped gyro sample), m.
+    pub rail_tilt: Vector2<f64>,
+    /// Whether a gyro sample sat at a rail.
+    pub gyro_clipped: bool,
+    /// The gravity the end's rest reads, turned into the start's level frame by the
+    /// integrated attitude: its horizontal part, m/s² (zero where the attitude came back
+    /// level).
+    pub end_leak: Vector2<f64>,
+    /// Samples from the start to the end.
+    pub samples: f64,
+    /// Sample period, s.
+    pub dt: f64,
+}
+
+impl Integration {
+    /// The core's displacement: the residual removed as a drift grown linearly over the
+    /// movement, the rails' tilt put back, m.
+    pub fn linear(&self) -> Vector3<f64> {
+        self.displacement - self.residual * (self.samples * self.dt / 2.0) + self.tilt()
+    }
+
+    /// The displacement with the residual removed as a velocity error that appeared at once at
+    /// sample `c` from the start (a touch-down's), rails' tilt put back, m.
+    pub fn step_at(&self, c: f64) -> Vector3<f64> {
+        self.displacement - self.residual * ((self.samples - c + 0.5) * self.dt) + self.tilt()
+    }
+
+    fn tilt(&self) -> Vector3<f64> {
+        Vector3::new(self.rail_tilt.x, self.rail_tilt.y, 0.0)
+    }
+}
+
+/// Stride `k`'s [`Integration`].
+pub fn integration(run: &CoreRun, k: usize) -> Result<Integration, Skipped> {
     let s = &run.strides[k];
     if !s.flags.valid() || s.flags.has(StrideFlags::BRIDGED) {
         return Err(Skipped::Flagged);
@@ -285,9 +334,16 @@ pub fn horizontal(run: &CoreRun, k: usize) -> Result<nalgebra::Vector2<f64>, Ski
             p += dir * (alpha * (n - c + 0.5) * dt);
         }
     }
-    p -= (v - v_end) * (n * dt / 2.0);
+    let level = q * up1;
+    // The leak of the gravity the sensor reads, m/s².
+    let leak = G * g_counts / unit;
+    let end_leak = if level.norm() > 0.0 {
+        level.xy() * (leak / level.norm())
+    } else {
+        Vector2::zeros()
+    };
+    let mut rail_tilt = Vector2::zeros();
     if clipped > 0 {
-        let level = q * up1;
         let (norm, lxy) = (level.norm(), level.xy().norm());
         if norm > 0.0 && lxy > 0.0 {
             let lost: f64 = rails
@@ -303,13 +359,19 @@ pub fn horizontal(run: &CoreRun, k: usize) -> Result<nalgebra::Vector2<f64>, Ski
                 level.xy() / norm
             };
             let w = n * s1 - s2;
-            // The leak of the gravity the sensor reads, in metres of the unit.
-            let leak = G * g_counts / unit;
-            p.x += h.x * w / clipped as f64 * leak * dt * dt / 2.0;
-            p.y += h.y * w / clipped as f64 * leak * dt * dt / 2.0;
+            rail_tilt.x = h.x * w / clipped as f64 * leak * dt * dt / 2.0;
+            rail_tilt.y = h.y * w / clipped as f64 * leak * dt * dt / 2.0;
         }
     }
-    Ok(p.xy())
+    Ok(Integration {
+        displacement: p,
+        residual: v - v_end,
+        rail_tilt,
+        gyro_clipped: clipped > 0,
+        end_leak,
+        samples: n,
+        dt,
+    })
 }
 
 /// [`gaitclip::detect::clipping::RailRun`] in `f64`: the parabola's area above the rail per clipped
