@@ -236,6 +236,13 @@ enum Cmd {
         #[arg(default_value = "../../shared/datasets")]
         datasets: PathBuf,
     },
+    /// What a level landing, a touch-down step or the end rest's gravity would do to the
+    /// length of strides whose length is known (the `f64` twin's integration).
+    Constraints {
+        /// The folder holding the datasets (`../shared/datasets`).
+        #[arg(default_value = "../../shared/datasets")]
+        datasets: PathBuf,
+    },
     /// The walk-jog-run-sprint courses of `esangeni_course` against their geometry: the
     /// total, the forward, backward and sideways parts (split by the foot's heading), strides
     /// by gait class, |climb| per stride, flags.
@@ -940,6 +947,9 @@ fn run(cli: Cli) -> anyhow::Result<()> {
         }
         Cmd::Running { datasets } => {
             print!("{}", gaitclip_host::eval::running::report(&datasets)?);
+        }
+        Cmd::Constraints { datasets } => {
+            print!("{}", gaitclip_host::eval::constraints::report(&datasets)?);
         }
         Cmd::Course { datasets } => {
             print!("{}", gaitclip_host::eval::course::report(&datasets)?);

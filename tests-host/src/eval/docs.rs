@@ -31,6 +31,7 @@ pub const GENERATORS: &[(&str, Generator)] = &[
     ("clipping", crate::eval::clip_sweep::report),
     ("rates", crate::eval::rate_sweep::report),
     ("running", crate::eval::running::report),
+    ("constraints", crate::eval::constraints::report),
     ("course", crate::eval::course::report),
     ("flags", crate::eval::flag_costs::report),
     ("bias", crate::eval::bias::report),

@@ -2,6 +2,7 @@
 
 pub mod bias;
 pub mod clip_sweep;
+pub mod constraints;
 pub mod course;
 pub mod daily;
 pub mod docs;
