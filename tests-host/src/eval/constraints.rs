@@ -17,7 +17,14 @@
 //! - **gravity at the end**: the horizontal part of the end rest's gravity, turned by the
 //!   integrated attitude, taken for a tilt error grown uniformly over the movement (a gyro
 //!   bias), whose leaked gravity is removed in closed form (−leak·T²/12 after the linear
-//!   dedrift); strides with a clipped gyro keep the core's rail correction instead.
+//!   dedrift); strides with a clipped gyro keep the core's rail correction instead;
+//! - **the walker's estimate** ([`LengthEstimator`], the mean of the last two measured
+//!   strides) where the integration is physically inconsistent, a foot at rest still moving
+//!   over 2 m/s by it (issue 45's proposal): on every stride, or only on those at a rail.
+//!
+//! Strides at a rail are scored twice more, where something measures them: `pyshoe_vicon`
+//! converted at ±4 g against the Vicon, and `esangeni_course` converted at a sprint's two
+//! rails against themselves as recorded (the clipping table's rows).
 //!
 //! The twin skips strides it cannot re-measure (bridged, without a contiguous stride before
 //! them); in a course's total those keep the core's length in every row.
@@ -25,7 +32,8 @@
 use std::path::Path;
 
 use anyhow::{Context, Result};
-use gaitclip::record::stride::{Stride, StrideFlags};
+use gaitclip::length::estimate::LengthEstimator;
+use gaitclip::record::stride::StrideFlags;
 use nalgebra::{Vector2, Vector3};
 
 use crate::eval::course::CourseTruth;
@@ -35,8 +43,9 @@ use crate::eval::matching::{self, Detected, Scored};
 use crate::eval::stats::{median, quantile};
 use crate::io::datasets;
 use crate::io::trace::Ranges;
-use crate::reference::cycle_ref::{self, Integration};
+use crate::reference::cycle_ref::{self, CoreRun, Integration, Skipped};
 use crate::{io::csv_trace, replay};
+use gaitclip_mpu6050::{AccelRange, GyroRange};
 
 /// A stride climbing more than this on a level floor is beyond issue 45's bound, m.
 const LEVEL_CLIMB_M: f64 = 0.15;
@@ -49,9 +58,11 @@ enum Finish {
     LevelLanding,
     LevelLandingOverBound,
     EndGravity,
+    EstimateOverResidual,
+    EstimateOverResidualClipped,
 }
 
-const FINISHES: [(Finish, &str); 5] = [
+const FINISHES: [(Finish, &str); 7] = [
     (
         Finish::Linear,
         "the core: the residual as a drift grown linearly",
@@ -72,14 +83,65 @@ const FINISHES: [(Finish, &str); 5] = [
         Finish::EndGravity,
         "gravity at the end: its tilt grown uniformly, leak removed",
     ),
+    (
+        Finish::EstimateOverResidual,
+        "the walker's estimate where the residual exceeds 2 m/s",
+    ),
+    (
+        Finish::EstimateOverResidualClipped,
+        "the same, on strides at a rail only",
+    ),
 ];
 
+/// `pyshoe_vicon` converted at the MPU6050's ±4 g: its walking and running strides at a rail
+/// (the clipping table's row), scored against the Vicon.
+const PYSHOE_RAILS: Ranges = Ranges {
+    accel: AccelRange::G4,
+    gyro: GyroRange::Dps2000,
+};
+
+/// A sprint's two rails on running strides that stayed inside ±16 g and ±2 000 °/s (the
+/// clipping table's last row): the MPU6050's ±8 g and ±1 000 °/s.
+const SPRINT_RAILS: Ranges = Ranges {
+    accel: AccelRange::G8,
+    gyro: GyroRange::Dps1000,
+};
+
+/// A foot at rest still moving this fast by the integration, m/s: beyond 99 % of
+/// `pyshoe_vicon`'s strides (p99 2.2 m/s), where issue 45 would take the estimate instead.
+const INCONSISTENT_RESIDUAL_M_S: f64 = 2.0;
+
+/// What a finish works from: the twin's integration of a stride, its heel strike (samples
+/// from the start) and the core's estimate for it from the strides before
+/// ([`LengthEstimator`]), m.
+#[derive(Clone, Copy, Debug, PartialEq)]
+struct Measured {
+    integration: Integration,
+    heel_strike: f64,
+    estimate_m: Option<f64>,
+    /// A sensor sat at a rail in the stride.
+    at_rail: bool,
+}
+
 impl Finish {
+    /// The length and climb of `m`, m.
+    fn length_and_climb(self, m: &Measured) -> (f64, f64) {
+        let d = self.displacement(&m.integration, m.heel_strike);
+        let inconsistent = m.integration.residual.norm() > INCONSISTENT_RESIDUAL_M_S;
+        match (self, m.estimate_m) {
+            (Finish::EstimateOverResidual, Some(e)) if inconsistent => (e, d.z),
+            (Finish::EstimateOverResidualClipped, Some(e)) if inconsistent && m.at_rail => (e, d.z),
+            _ => (d.xy().norm(), d.z),
+        }
+    }
+
     /// The displacement, m, of `x` (heel strike `hs` samples from the start).
     fn displacement(self, x: &Integration, hs: f64) -> Vector3<f64> {
         let linear = x.linear();
         match self {
-            Finish::Linear => linear,
+            Finish::Linear | Finish::EstimateOverResidual | Finish::EstimateOverResidualClipped => {
+                linear
+            }
             Finish::StepAtHeelStrike => x.step_at(hs),
             Finish::LevelLanding => level(x, hs),
             Finish::LevelLandingOverBound if linear.z.abs() > LEVEL_CLIMB_M => level(x, hs),
@@ -109,24 +171,39 @@ fn level(x: &Integration, hs: f64) -> Vector3<f64> {
     linear * a + step * (1.0 - a)
 }
 
-/// A matched stride: its reference length and speed, and its integration.
+/// A matched stride: its reference length and speed, and what the finishes work from.
 struct Known {
     speed_m_s: f64,
     length_m: f64,
-    integration: Integration,
-    heel_strike: f64,
+    measured: Measured,
 }
 
-/// The heel strike of `s`, samples from its start.
-fn heel_strike(s: &Stride) -> f64 {
-    s.events.heel_strike.saturating_sub(s.events.start) as f64
+/// Per stride of `run`, in order, what the finishes work from (`Err`: the twin skips it).
+fn measured(run: &CoreRun) -> Vec<Result<Measured, Skipped>> {
+    let mut estimator = LengthEstimator::new();
+    run.strides
+        .iter()
+        .enumerate()
+        .map(|(k, s)| {
+            let estimate_m = estimator.estimate_mm().map(|mm| mm as f64 / 1e3);
+            estimator.process(&mut s.clone());
+            cycle_ref::integration(run, k).map(|integration| Measured {
+                integration,
+                heel_strike: s.events.heel_strike.saturating_sub(s.events.start) as f64,
+                estimate_m,
+                at_rail: s
+                    .flags
+                    .has(StrideFlags::ACCEL_CLIPPED | StrideFlags::GYRO_CLIPPED),
+            })
+        })
+        .collect()
 }
 
-/// Every clean matched stride of the dataset in `dir` with a reference length that the twin
-/// re-measures.
-fn known(dir: &Path) -> Result<Vec<Known>> {
+/// Every clean matched stride of the dataset in `dir`, converted at `ranges`, with a
+/// reference length that the twin re-measures (`at_rail`: only those with a sensor at a
+/// rail).
+fn known(dir: &Path, ranges: Ranges, at_rail: bool) -> Result<Vec<Known>> {
     let d = datasets::load(dir)?;
-    let ranges = Ranges::default();
     let mut out = Vec::new();
     for trial in &d.trials {
         let t = csv_trace::read(&trial.csv, Some(d.rate_hz))?;
@@ -134,6 +211,7 @@ fn known(dir: &Path) -> Result<Vec<Known>> {
         let run = cycle_ref::run(&p.counts, &p.clock.holes, p.config(ranges));
         let det: Vec<Detected> = run.strides.iter().map(Detected::from).collect();
         let refs = trial.references_in_numbers(&p.clock);
+        let measured = measured(&run);
         for (i, c) in matching::classify(trial, &p.clock, &det, &refs)
             .iter()
             .enumerate()
@@ -143,26 +221,65 @@ fn known(dir: &Path) -> Result<Vec<Known>> {
             if !s.flags.valid() || s.flags.has(StrideFlags::FROM_REST | StrideFlags::TO_REST) {
                 continue;
             }
-            let (Some(length_m), Ok(integration)) = (r.length_m, cycle_ref::integration(&run, i))
-            else {
+            let (Some(length_m), Ok(measured)) = (r.length_m, measured[i]) else {
                 continue;
             };
+            if at_rail && !measured.at_rail {
+                continue;
+            }
             out.push(Known {
                 speed_m_s: length_m / ((r.end - r.start) as f64 * p.clock.period_s),
                 length_m,
-                integration,
-                heel_strike: heel_strike(s),
+                measured,
             });
         }
     }
     Ok(out)
 }
 
-/// A course: its length, and per stride the twin's integration and heel strike (or, where
-/// the twin skips it, the core's length, m).
+/// The strides of the dataset in `dir` that converting it at `ranges` put at a rail, with
+/// the length the core measures of them as recorded (none of their samples at a rail) for
+/// reference: the rails' loss and nothing else.
+fn against_unclipped(dir: &Path, ranges: Ranges) -> Result<Vec<Known>> {
+    let d = datasets::load(dir)?;
+    let clip = StrideFlags::ACCEL_CLIPPED | StrideFlags::GYRO_CLIPPED;
+    let mut out = Vec::new();
+    for trial in &d.trials {
+        let t = csv_trace::read(&trial.csv, Some(d.rate_hz))?;
+        let recorded = replay::prepare(&t, Ranges::default())?;
+        let refs = recorded.strides(recorded.config(Ranges::default()));
+        let p = replay::prepare(&t, ranges)?;
+        let run = cycle_ref::run(&p.counts, &p.clock.holes, p.config(ranges));
+        for (s, m) in run.strides.iter().zip(measured(&run)) {
+            let Ok(measured) = m else { continue };
+            if !measured.at_rail || s.flags.has(StrideFlags::GAP) {
+                continue;
+            }
+            let Some(r) = refs
+                .iter()
+                .find(|r| r.events.start == s.events.start && r.events.end == s.events.end)
+            else {
+                continue;
+            };
+            if r.flags.has(clip) || !r.flags.valid() {
+                continue;
+            }
+            let length_m = r.zupt_um as f64 / 1e6;
+            out.push(Known {
+                speed_m_s: length_m / ((r.events.end - r.events.start) as f64 * p.clock.period_s),
+                length_m,
+                measured,
+            });
+        }
+    }
+    Ok(out)
+}
+
+/// A course: its length, and per stride what the finishes work from (or, where the twin
+/// skips it, the core's length, m).
 struct CourseRun {
     course_m: f64,
-    strides: Vec<Result<(Integration, f64), f64>>,
+    strides: Vec<Result<Measured, f64>>,
 }
 
 fn course_runs(dir: &Path) -> Result<Vec<CourseRun>> {
@@ -177,14 +294,12 @@ fn course_runs(dir: &Path) -> Result<Vec<CourseRun>> {
         let t = csv_trace::read(&dir.join(format!("{}.csv", truth.trial)), Some(d.rate_hz))?;
         let p = replay::prepare(&t, ranges)?;
         let run = cycle_ref::run(&p.counts, &p.clock.holes, p.config(ranges));
-        let strides = (0..run.strides.len())
-            .filter(|&k| run.strides[k].zupt_um > 0)
-            .map(|k| {
-                let s = &run.strides[k];
-                cycle_ref::integration(&run, k)
-                    .map(|x| (x, heel_strike(s)))
-                    .map_err(|_| s.zupt_um as f64 / 1e6)
-            })
+        let strides = run
+            .strides
+            .iter()
+            .zip(measured(&run))
+            .filter(|(s, _)| s.zupt_um > 0)
+            .map(|(s, m)| m.map_err(|_| s.zupt_um as f64 / 1e6))
             .collect();
         out.push(CourseRun {
             course_m: truth.course_m,
@@ -196,8 +311,10 @@ fn course_runs(dir: &Path) -> Result<Vec<CourseRun>> {
 
 /// The table, Markdown.
 pub fn report(root: &Path) -> Result<String> {
-    let pyshoe = known(&root.join("pyshoe_vicon"))?;
-    let gaitmap = known(&root.join("gaitmap_walk"))?;
+    let pyshoe = known(&root.join("pyshoe_vicon"), Ranges::default(), false)?;
+    let gaitmap = known(&root.join("gaitmap_walk"), Ranges::default(), false)?;
+    let pyshoe_4g = known(&root.join("pyshoe_vicon"), PYSHOE_RAILS, true)?;
+    let course_rails = against_unclipped(&root.join("esangeni_course"), SPRINT_RAILS)?;
     let courses = course_runs(&root.join("esangeni_course"))?;
     let mut header = vec!["finish".to_string()];
     for (lo, hi) in SPEED_BINS {
@@ -208,6 +325,8 @@ pub fn report(root: &Path) -> Result<String> {
         });
     }
     header.push("`gaitmap_walk`".into());
+    header.push("`pyshoe_vicon` at ±4 g: strides at a rail".into());
+    header.push("`esangeni_course` at ±8 g, ±1 000 °/s: strides newly at a rail, against themselves as recorded".into());
     header.push("`esangeni_course` |total error| median / worst".into());
     header.push("courses' |climb| p95 / max m".into());
     let mut t = Table::new(header);
@@ -215,30 +334,27 @@ pub fn report(root: &Path) -> Result<String> {
         let errors = |k: &[Known], (lo, hi): (f64, f64)| -> Vec<f64> {
             k.iter()
                 .filter(|x| x.speed_m_s >= lo && x.speed_m_s < hi)
-                .map(|x| {
-                    finish
-                        .displacement(&x.integration, x.heel_strike)
-                        .xy()
-                        .norm()
-                        - x.length_m
-                })
+                .map(|x| finish.length_and_climb(&x.measured).0 - x.length_m)
                 .collect()
         };
         let mut row = vec![name.to_string()];
         for bin in SPEED_BINS {
             row.push(cm_cell(&errors(&pyshoe, bin)));
         }
-        row.push(cm_cell(&errors(&gaitmap, (0.0, f64::INFINITY))));
+        let every = (0.0, f64::INFINITY);
+        row.push(cm_cell(&errors(&gaitmap, every)));
+        row.push(cm_cell(&errors(&pyshoe_4g, every)));
+        row.push(cm_cell(&errors(&course_rails, every)));
         let mut totals = Vec::new();
         let mut climbs = Vec::new();
         for c in &courses {
             let mut total = 0.0;
             for s in &c.strides {
                 match s {
-                    Ok((x, hs)) => {
-                        let d = finish.displacement(x, *hs);
-                        total += d.xy().norm();
-                        climbs.push(d.z.abs());
+                    Ok(m) => {
+                        let (length, climb) = finish.length_and_climb(m);
+                        total += length;
+                        climbs.push(climb.abs());
                     }
                     Err(core_m) => total += core_m,
                 }
@@ -260,12 +376,12 @@ pub fn report(root: &Path) -> Result<String> {
     let leak = |k: &[Known]| {
         median(
             &k.iter()
-                .map(|x| x.integration.end_leak.norm())
+                .map(|x| x.measured.integration.end_leak.norm())
                 .collect::<Vec<_>>(),
         )
     };
     Ok(format!(
-        "The same strides finished five ways, the `f64` twin's integration of the core's own \
+        "The same strides finished seven ways, the `f64` twin's integration of the core's own \
          strides (clean matched strides, against the reference's length: RMSE / bias cm (strides); \
          the courses' total against their geometry, the twin's strides only for |climb|). The \
          gravity the end's rest leaks through the integrated attitude: median {:.2} m/s² on \
