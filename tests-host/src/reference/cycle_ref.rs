@@ -169,6 +169,12 @@ pub struct Integration {
     /// integrated attitude: its horizontal part, m/s² (zero where the attitude came back
     /// level).
     pub end_leak: Vector2<f64>,
+    /// The sample of the largest acceleration in the movement's second half, from the start
+    /// (a touch-down's impact).
+    pub impact: f64,
+    /// The largest accelerometer reading against its axis's rail, 0–1 (1: at the rail; 0
+    /// without rails).
+    pub of_rail: f64,
     /// Samples from the start to the end.
     pub samples: f64,
     /// Sample period, s.
@@ -257,6 +263,8 @@ pub fn integration(run: &CoreRun, k: usize) -> Result<Integration, Skipped> {
     let mut steps: Vec<(Vector3<f64>, f64)> = Vec::new();
     let mut singles: Vec<(Vector3<f64>, f64)> = Vec::new();
     let (mut min_rail, mut climbs) = (f64::INFINITY, 0f64);
+    let (mut impact, mut impact_a, mut of_rail) = (0f64, 0f64, 0f64);
+    let half = (i1 - i0) / 2;
     let to_mps = G / unit * dt;
     let mut book = |k: usize,
                     (len, area, climb): Done,
@@ -282,6 +290,15 @@ pub fn integration(run: &CoreRun, k: usize) -> Result<Integration, Skipped> {
         let v_prev = v;
         v += a * dt;
         p += (v_prev + v) * (dt / 2.0);
+        if c >= half && a.norm() > impact_a {
+            (impact, impact_a) = ((c + 1) as f64, a.norm());
+        }
+        for (k, &raw) in x.accel.iter().enumerate() {
+            let rail = config_rails.accel[k].min_magnitude();
+            if rail > 0 {
+                of_rail = of_rail.max((raw as f64).abs() / rail as f64);
+            }
+        }
         let m = q.to_rotation_matrix();
         for k in 0..3 {
             let raw = x.accel[k];
@@ -369,6 +386,8 @@ pub fn integration(run: &CoreRun, k: usize) -> Result<Integration, Skipped> {
         rail_tilt,
         gyro_clipped: clipped > 0,
         end_leak,
+        impact,
+        of_rail: of_rail.min(1.0),
         samples: n,
         dt,
     })
