@@ -106,6 +106,7 @@ fn every_subcommand_is_listed_here() {
         "sprint",
         "rates",
         "running",
+        "constraints",
         "course",
         "flags",
         "daily",
