@@ -400,6 +400,20 @@ pub fn bias_m(
     Ok((mean(&e), e.len()))
 }
 
+/// The lever arm `h` under which dataset `d`'s mean ZUPT error is zero, m: the bias is
+/// linear in `h` (the rolling velocity `ω × h·up` is), so the line through `h = 0` and the
+/// default 80 mm gives it.
+pub fn zeroing_h_m(d: &Loaded) -> Result<f64> {
+    let (b0, _) = bias_m(
+        d,
+        &unchanged,
+        &|c: &mut Config| c.sensor_height_um = 0,
+        None,
+    )?;
+    let (b80, _) = bias_m(d, &unchanged, &after, None)?;
+    Ok(-b0 / ((b80 - b0) / 0.08))
+}
+
 /// The configuration before the bias study: the rest's departure from 1 g read as a gain.
 pub fn before(c: &mut Config) {
     c.gravity_reading = GravityReading::Gain;
@@ -569,16 +583,7 @@ fn lever_table(with_lengths: &[Loaded], ipol: &Loaded) -> Result<String> {
             .iter()
             .position(|x| x.dataset.name == d.dataset.name)
         {
-            Some(_) => {
-                let (b0, _) = bias_m(
-                    d,
-                    &unchanged,
-                    &|c: &mut Config| c.sensor_height_um = 0,
-                    None,
-                )?;
-                let (b80, _) = bias_m(d, &unchanged, &after, None)?;
-                format!("{:.0}", -b0 / ((b80 - b0) / 0.08) * 1e3)
-            }
+            Some(_) => format!("{:.0}", zeroing_h_m(d)? * 1e3),
             None => "– (no per-stride lengths)".into(),
         };
         t.row([
