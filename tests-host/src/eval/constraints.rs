@@ -34,12 +34,12 @@
 
 use std::path::Path;
 
-use anyhow::{Context, Result};
+use anyhow::Result;
 use gaitclip::length::estimate::LengthEstimator;
 use gaitclip::record::stride::StrideFlags;
 use nalgebra::{Vector2, Vector3};
 
-use crate::eval::course::CourseTruth;
+use crate::eval::course;
 use crate::eval::length_eval::SPEED_BINS;
 use crate::eval::markdown::{cm_cell, Table};
 use crate::eval::matching::{self, Detected, Scored};
@@ -297,30 +297,24 @@ struct CourseRun {
 }
 
 fn course_runs(dir: &Path) -> Result<Vec<CourseRun>> {
-    let d = datasets::load(dir)?;
-    let truths_csv = dir.join("trials.csv");
-    let mut reader = csv::Reader::from_path(&truths_csv)
-        .with_context(|| format!("reading {}", truths_csv.display()))?;
     let ranges = Ranges::default();
-    let mut out = Vec::new();
-    for row in reader.deserialize::<CourseTruth>() {
-        let truth = row.with_context(|| format!("a row of {}", truths_csv.display()))?;
-        let t = csv_trace::read(&dir.join(format!("{}.csv", truth.trial)), Some(d.rate_hz))?;
-        let p = replay::prepare(&t, ranges)?;
-        let run = cycle_ref::run(&p.counts, &p.clock.holes, p.config(ranges));
-        let strides = run
-            .strides
-            .iter()
-            .zip(measured(&run))
-            .filter(|(s, _)| s.zupt_um > 0)
-            .map(|(s, m)| m.map_err(|_| s.zupt_um as f64 / 1e6))
-            .collect();
-        out.push(CourseRun {
-            course_m: truth.course_m,
-            strides,
-        });
-    }
-    Ok(out)
+    Ok(course::prepared(dir)?
+        .into_iter()
+        .map(|(truth, p)| {
+            let run = cycle_ref::run(&p.counts, &p.clock.holes, p.config(ranges));
+            let strides = run
+                .strides
+                .iter()
+                .zip(measured(&run))
+                .filter(|(s, _)| s.zupt_um > 0)
+                .map(|(s, m)| m.map_err(|_| s.zupt_um as f64 / 1e6))
+                .collect();
+            CourseRun {
+                course_m: truth.course_m,
+                strides,
+            }
+        })
+        .collect())
 }
 
 /// The table, Markdown.

@@ -161,32 +161,41 @@ pub struct Course {
 }
 
 /// Every course of the folder `dir` (`trials.csv` with the lengths, `meta.json`, one CSV
-/// per trial), replayed with the shipped configuration.
-pub fn courses(dir: &Path) -> Result<Vec<Course>> {
+/// per trial), its recording prepared for the core at the default ranges.
+pub fn prepared(dir: &Path) -> Result<Vec<(CourseTruth, replay::Prepared)>> {
     let d = datasets::load(dir)?;
     let truths_csv = dir.join("trials.csv");
     let mut reader = csv::Reader::from_path(&truths_csv)
         .with_context(|| format!("reading {}", truths_csv.display()))?;
-    let ranges = Ranges::default();
     let mut out = Vec::new();
     for row in reader.deserialize::<CourseTruth>() {
         let truth = row.with_context(|| format!("a row of {}", truths_csv.display()))?;
-        let csv = dir.join(format!("{}.csv", truth.trial));
-        let t = csv_trace::read(&csv, Some(d.rate_hz))?;
-        let p = replay::prepare(&t, ranges)?;
-        let config = p.config(ranges);
-        let (strides, summary) = p.run(config);
-        let strides = strides
-            .into_iter()
-            .map(|(s, _)| replay::report(s, config, &|n| p.clock.t_s(n)))
-            .collect();
-        out.push(Course {
-            truth,
-            strides,
-            summary,
-        });
+        let t = csv_trace::read(&dir.join(format!("{}.csv", truth.trial)), Some(d.rate_hz))?;
+        let p = replay::prepare(&t, Ranges::default())?;
+        out.push((truth, p));
     }
     Ok(out)
+}
+
+/// Every course of the folder `dir` ([`prepared`]), replayed with the shipped configuration.
+pub fn courses(dir: &Path) -> Result<Vec<Course>> {
+    let ranges = Ranges::default();
+    Ok(prepared(dir)?
+        .into_iter()
+        .map(|(truth, p)| {
+            let config = p.config(ranges);
+            let (strides, summary) = p.run(config);
+            let strides = strides
+                .into_iter()
+                .map(|(s, _)| replay::report(s, config, &|n| p.clock.t_s(n)))
+                .collect();
+            Course {
+                truth,
+                strides,
+                summary,
+            }
+        })
+        .collect())
 }
 
 fn against(measured: f64, truth: f64) -> String {
