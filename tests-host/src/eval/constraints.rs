@@ -25,6 +25,9 @@
 //!   stands at over 2 m/s, the residual taken for what an impact beyond the rail took at the
 //!   sample the sensor saw largest (a sensor that filters after it clips shows no flat run).
 //!
+//! A second table asks the sensors' clocks: the core's finish with the attitude integrated
+//! from the gyro read one or two samples early or late against the accelerometer.
+//!
 //! Strides at a rail are scored twice more, where something measures them: `pyshoe_vicon`
 //! converted at ±4 g against the Vicon, and `esangeni_course` converted at a sprint's two
 //! rails against themselves as recorded (the clipping table's rows).
@@ -193,7 +196,7 @@ struct Known {
 }
 
 /// Per stride of `run`, in order, what the finishes work from (`Err`: the twin skips it).
-fn measured(run: &CoreRun) -> Vec<Result<Measured, Skipped>> {
+fn measured(run: &CoreRun, gyro_shift: i32) -> Vec<Result<Measured, Skipped>> {
     let mut estimator = LengthEstimator::new();
     run.strides
         .iter()
@@ -201,7 +204,7 @@ fn measured(run: &CoreRun) -> Vec<Result<Measured, Skipped>> {
         .map(|(k, s)| {
             let estimate_m = estimator.estimate_mm().map(|mm| mm as f64 / 1e3);
             estimator.process(&mut s.clone());
-            cycle_ref::integration(run, k).map(|integration| Measured {
+            cycle_ref::integration_shifted(run, k, gyro_shift).map(|integration| Measured {
                 integration,
                 heel_strike: s.events.heel_strike.saturating_sub(s.events.start) as f64,
                 estimate_m,
@@ -216,7 +219,7 @@ fn measured(run: &CoreRun) -> Vec<Result<Measured, Skipped>> {
 /// Every clean matched stride of the dataset in `dir`, converted at `ranges`, with a
 /// reference length that the twin re-measures (`at_rail`: only those with a sensor at a
 /// rail).
-fn known(dir: &Path, ranges: Ranges, at_rail: bool) -> Result<Vec<Known>> {
+fn known(dir: &Path, ranges: Ranges, at_rail: bool, gyro_shift: i32) -> Result<Vec<Known>> {
     let d = datasets::load(dir)?;
     let mut out = Vec::new();
     for trial in &d.trials {
@@ -225,7 +228,7 @@ fn known(dir: &Path, ranges: Ranges, at_rail: bool) -> Result<Vec<Known>> {
         let run = cycle_ref::run(&p.counts, &p.clock.holes, p.config(ranges));
         let det: Vec<Detected> = run.strides.iter().map(Detected::from).collect();
         let refs = trial.references_in_numbers(&p.clock);
-        let measured = measured(&run);
+        let measured = measured(&run, gyro_shift);
         for (i, c) in matching::classify(trial, &p.clock, &det, &refs)
             .iter()
             .enumerate()
@@ -254,7 +257,7 @@ fn known(dir: &Path, ranges: Ranges, at_rail: bool) -> Result<Vec<Known>> {
 /// The strides of the dataset in `dir` that converting it at `ranges` put at a rail, with
 /// the length the core measures of them as recorded (none of their samples at a rail) for
 /// reference: the rails' loss and nothing else.
-fn against_unclipped(dir: &Path, ranges: Ranges) -> Result<Vec<Known>> {
+fn against_unclipped(dir: &Path, ranges: Ranges, gyro_shift: i32) -> Result<Vec<Known>> {
     let d = datasets::load(dir)?;
     let clip = StrideFlags::ACCEL_CLIPPED | StrideFlags::GYRO_CLIPPED;
     let mut out = Vec::new();
@@ -264,7 +267,7 @@ fn against_unclipped(dir: &Path, ranges: Ranges) -> Result<Vec<Known>> {
         let refs = recorded.strides(recorded.config(Ranges::default()));
         let p = replay::prepare(&t, ranges)?;
         let run = cycle_ref::run(&p.counts, &p.clock.holes, p.config(ranges));
-        for (s, m) in run.strides.iter().zip(measured(&run)) {
+        for (s, m) in run.strides.iter().zip(measured(&run, gyro_shift)) {
             let Ok(measured) = m else { continue };
             if !measured.at_rail || s.flags.has(StrideFlags::GAP) {
                 continue;
@@ -296,7 +299,7 @@ struct CourseRun {
     strides: Vec<Result<Measured, f64>>,
 }
 
-fn course_runs(dir: &Path) -> Result<Vec<CourseRun>> {
+fn course_runs(dir: &Path, gyro_shift: i32) -> Result<Vec<CourseRun>> {
     let ranges = Ranges::default();
     Ok(course::prepared(dir)?
         .into_iter()
@@ -305,7 +308,7 @@ fn course_runs(dir: &Path) -> Result<Vec<CourseRun>> {
             let strides = run
                 .strides
                 .iter()
-                .zip(measured(&run))
+                .zip(measured(&run, gyro_shift))
                 .filter(|(s, _)| s.zupt_um > 0)
                 .map(|(s, m)| m.map_err(|_| s.zupt_um as f64 / 1e6))
                 .collect();
@@ -317,28 +320,57 @@ fn course_runs(dir: &Path) -> Result<Vec<CourseRun>> {
         .collect())
 }
 
-/// The table, Markdown.
-pub fn report(root: &Path) -> Result<String> {
-    let pyshoe = known(&root.join("pyshoe_vicon"), Ranges::default(), false)?;
-    let gaitmap = known(&root.join("gaitmap_walk"), Ranges::default(), false)?;
-    let pyshoe_4g = known(&root.join("pyshoe_vicon"), PYSHOE_RAILS, true)?;
-    let course_rails = against_unclipped(&root.join("esangeni_course"), SPRINT_RAILS)?;
-    let courses = course_runs(&root.join("esangeni_course"))?;
-    let mut header = vec!["finish".to_string()];
-    for (lo, hi) in SPEED_BINS {
-        header.push(if hi.is_finite() {
-            format!("`pyshoe_vicon` {lo}–{hi} m/s")
-        } else {
-            format!("`pyshoe_vicon` > {lo} m/s")
-        });
+/// Everything the tables score, integrated with the gyro read `gyro_shift` samples late.
+struct Sets {
+    pyshoe: Vec<Known>,
+    gaitmap: Vec<Known>,
+    pyshoe_4g: Vec<Known>,
+    course_rails: Vec<Known>,
+    courses: Vec<CourseRun>,
+}
+
+impl Sets {
+    fn of(root: &Path, gyro_shift: i32) -> Result<Self> {
+        let course = root.join("esangeni_course");
+        Ok(Sets {
+            pyshoe: known(
+                &root.join("pyshoe_vicon"),
+                Ranges::default(),
+                false,
+                gyro_shift,
+            )?,
+            gaitmap: known(
+                &root.join("gaitmap_walk"),
+                Ranges::default(),
+                false,
+                gyro_shift,
+            )?,
+            pyshoe_4g: known(&root.join("pyshoe_vicon"), PYSHOE_RAILS, true, gyro_shift)?,
+            course_rails: against_unclipped(&course, SPRINT_RAILS, gyro_shift)?,
+            courses: course_runs(&course, gyro_shift)?,
+        })
     }
-    header.push("`gaitmap_walk`".into());
-    header.push("`pyshoe_vicon` at ±4 g: strides at a rail".into());
-    header.push("`esangeni_course` at ±8 g, ±1 000 °/s: strides newly at a rail, against themselves as recorded".into());
-    header.push("`esangeni_course` |total error| median / worst".into());
-    header.push("courses' |climb| p95 / max m".into());
-    let mut t = Table::new(header);
-    for (finish, name) in FINISHES {
+
+    /// The table's header, its first column named `first`.
+    fn header(first: &str) -> Vec<String> {
+        let mut header = vec![first.to_string()];
+        for (lo, hi) in SPEED_BINS {
+            header.push(if hi.is_finite() {
+                format!("`pyshoe_vicon` {lo}–{hi} m/s")
+            } else {
+                format!("`pyshoe_vicon` > {lo} m/s")
+            });
+        }
+        header.push("`gaitmap_walk`".into());
+        header.push("`pyshoe_vicon` at ±4 g: strides at a rail".into());
+        header.push("`esangeni_course` at ±8 g, ±1 000 °/s: strides newly at a rail, against themselves as recorded".into());
+        header.push("`esangeni_course` |total error| median / worst".into());
+        header.push("courses' |climb| p95 / max m".into());
+        header
+    }
+
+    /// The row of `finish`, named `name`.
+    fn row(&self, finish: Finish, name: &str) -> Vec<String> {
         let errors = |k: &[Known], (lo, hi): (f64, f64)| -> Vec<f64> {
             k.iter()
                 .filter(|x| x.speed_m_s >= lo && x.speed_m_s < hi)
@@ -347,15 +379,15 @@ pub fn report(root: &Path) -> Result<String> {
         };
         let mut row = vec![name.to_string()];
         for bin in SPEED_BINS {
-            row.push(cm_cell(&errors(&pyshoe, bin)));
+            row.push(cm_cell(&errors(&self.pyshoe, bin)));
         }
         let every = (0.0, f64::INFINITY);
-        row.push(cm_cell(&errors(&gaitmap, every)));
-        row.push(cm_cell(&errors(&pyshoe_4g, every)));
-        row.push(cm_cell(&errors(&course_rails, every)));
+        row.push(cm_cell(&errors(&self.gaitmap, every)));
+        row.push(cm_cell(&errors(&self.pyshoe_4g, every)));
+        row.push(cm_cell(&errors(&self.course_rails, every)));
         let mut totals = Vec::new();
         let mut climbs = Vec::new();
-        for c in &courses {
+        for c in &self.courses {
             let mut total = 0.0;
             for s in &c.strides {
                 match s {
@@ -379,7 +411,20 @@ pub fn report(root: &Path) -> Result<String> {
             quantile(&climbs, 0.95),
             climbs.iter().copied().fold(0.0, f64::max)
         ));
-        t.row(row);
+        row
+    }
+}
+
+/// The gyro read this many samples late (negative: early) against the accelerometer, for the
+/// clock's table.
+const GYRO_SHIFTS: [i32; 5] = [-2, -1, 0, 1, 2];
+
+/// The tables, Markdown.
+pub fn report(root: &Path) -> Result<String> {
+    let sets = Sets::of(root, 0)?;
+    let mut t = Table::new(Sets::header("finish"));
+    for (finish, name) in FINISHES {
+        t.row(sets.row(finish, name));
     }
     let leak = |k: &[Known]| {
         median(
@@ -388,15 +433,47 @@ pub fn report(root: &Path) -> Result<String> {
                 .collect::<Vec<_>>(),
         )
     };
+    let residual = |k: &[Known]| {
+        median(
+            &k.iter()
+                .map(|x| x.measured.integration.residual.norm())
+                .collect::<Vec<_>>(),
+        )
+    };
+    let mut clock = Table::new(Sets::header("gyro against the accelerometer"));
+    let mut residuals = Vec::new();
+    for shift in GYRO_SHIFTS {
+        let shifted = Sets::of(root, shift)?;
+        let samples = |d: i32| match d.abs() {
+            1 => "1 sample".to_string(),
+            n => format!("{n} samples"),
+        };
+        let name = match shift {
+            0 => "as recorded (the core)".to_string(),
+            d if d < 0 => format!("{} early", samples(d)),
+            d => format!("{} late", samples(d)),
+        };
+        residuals.push(format!(
+            "{name}: {:.2} / {:.2}",
+            residual(&shifted.pyshoe),
+            residual(&shifted.gaitmap)
+        ));
+        clock.row(shifted.row(Finish::Linear, &name));
+    }
     Ok(format!(
         "The same strides finished eight ways, the `f64` twin's integration of the core's own \
          strides (clean matched strides, against the reference's length: RMSE / bias cm (strides); \
          the courses' total against their geometry, the twin's strides only for |climb|). The \
          gravity the end's rest leaks through the integrated attitude: median {:.2} m/s² on \
-         `pyshoe_vicon`'s strides, {:.2} m/s² on `gaitmap_walk`'s.\n\n{}",
-        leak(&pyshoe),
-        leak(&gaitmap),
-        t.render()
+         `pyshoe_vicon`'s strides, {:.2} m/s² on `gaitmap_walk`'s.\n\n{}\n\
+         The sensors' clocks: the core's finish with the gyro read a sample or two early or late \
+         against the accelerometer (the median |residual|, m/s, `pyshoe_vicon` / `gaitmap_walk`: \
+         {}):\n\n{}",
+        leak(&sets.pyshoe),
+        leak(&sets.gaitmap),
+        t.render(),
+        residuals.join("; "),
+        clock.render()
     ))
 }
 

@@ -201,6 +201,17 @@ impl Integration {
 
 /// Stride `k`'s [`Integration`].
 pub fn integration(run: &CoreRun, k: usize) -> Result<Integration, Skipped> {
+    integration_shifted(run, k, 0)
+}
+
+/// Stride `k`'s [`Integration`] with the gyro read `gyro_shift` samples late against the
+/// accelerometer (negative: early; a sample the shift reaches outside the recording, or
+/// into a hole, is the unshifted one): a delay between the two sensors' clocks.
+pub fn integration_shifted(
+    run: &CoreRun,
+    k: usize,
+    gyro_shift: i32,
+) -> Result<Integration, Skipped> {
     let s = &run.strides[k];
     if !s.flags.valid() || s.flags.has(StrideFlags::BRIDGED) {
         return Err(Skipped::Flagged);
@@ -283,7 +294,12 @@ pub fn integration(run: &CoreRun, k: usize) -> Result<Integration, Skipped> {
     };
     for (c, i) in (i0 + 1..=i1).enumerate() {
         let x = run.sample(i)?;
-        q *= UnitQuaternion::from_scaled_axis(omega(&x, cal0.gyro_bias) * dt);
+        let gyro = (i as i64 + gyro_shift as i64)
+            .try_into()
+            .ok()
+            .and_then(|at: usize| run.sample(at).ok())
+            .unwrap_or(x);
+        q *= UnitQuaternion::from_scaled_axis(omega(&gyro, cal0.gyro_bias) * dt);
         let f =
             q * (Vector3::new(x.accel[0] as f64, x.accel[1] as f64, x.accel[2] as f64) - offset);
         let a = (f - Vector3::new(0.0, 0.0, g_counts)) * (G / unit);
