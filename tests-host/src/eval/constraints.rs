@@ -122,6 +122,10 @@ const SPRINT_RAILS: Ranges = Ranges {
 /// `pyshoe_vicon`'s strides (p99 2.2 m/s), where issue 45 would take the estimate instead.
 const INCONSISTENT_RESIDUAL_M_S: f64 = 2.0;
 
+/// An accelerometer reading this near its axis's rail (its share of the rail) counts as
+/// near it: within 10 %.
+const NEAR_RAIL: f64 = 0.9;
+
 /// What a finish works from: the twin's integration of a stride, its heel strike (samples
 /// from the start) and the core's estimate for it from the strides before
 /// ([`LengthEstimator`]), m.
@@ -158,7 +162,7 @@ impl Finish {
             Finish::LevelLandingOverBound if linear.z.abs() > LEVEL_CLIMB_M => level(x, hs),
             Finish::LevelLandingOverBound => linear,
             Finish::StepNearRail
-                if x.of_rail >= 0.9 && x.residual.norm() > INCONSISTENT_RESIDUAL_M_S =>
+                if x.of_rail >= NEAR_RAIL && x.residual.norm() > INCONSISTENT_RESIDUAL_M_S =>
             {
                 x.step_at(x.impact)
             }
