@@ -175,8 +175,9 @@ fn clamp_trace(t: &Trace, g: f64) -> Trace {
     out
 }
 
-/// The unclipped stride between the same two instants as `s`.
-fn same_instants<'a>(s: &Stride, refs: &'a [Stride]) -> Option<&'a Stride> {
+/// The stride of `refs` (a replay of the same recording, unclipped) between the same two
+/// instants as `s`.
+pub fn same_instants<'a>(s: &Stride, refs: &'a [Stride]) -> Option<&'a Stride> {
     refs.iter()
         .find(|r| r.events.start == s.events.start && r.events.end == s.events.end)
 }

@@ -42,6 +42,7 @@ use gaitclip::length::estimate::LengthEstimator;
 use gaitclip::record::stride::StrideFlags;
 use nalgebra::{Vector2, Vector3};
 
+use crate::eval::clip_sweep::same_instants;
 use crate::eval::course;
 use crate::eval::length_eval::SPEED_BINS;
 use crate::eval::markdown::{cm_cell, Table};
@@ -276,10 +277,7 @@ fn against_unclipped(dir: &Path, ranges: Ranges, gyro_shift: i32) -> Result<Vec<
             if !measured.at_rail || s.flags.has(StrideFlags::GAP) {
                 continue;
             }
-            let Some(r) = refs
-                .iter()
-                .find(|r| r.events.start == s.events.start && r.events.end == s.events.end)
-            else {
+            let Some(r) = same_instants(s, &refs) else {
                 continue;
             };
             if r.flags.has(clip) || !r.flags.valid() {

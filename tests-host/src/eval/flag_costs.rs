@@ -298,10 +298,7 @@ fn gyro_clipped(d: &datasets::Dataset, ranges: Ranges) -> Result<Vec<f64>> {
             if !s.flags.has(StrideFlags::GYRO_CLIPPED) {
                 continue;
             }
-            if let Some(w) = want
-                .iter()
-                .find(|w| w.events.start == s.events.start && w.events.end == s.events.end)
-            {
+            if let Some(w) = clip_sweep::same_instants(&s, &want) {
                 e.push((s.length_mm as f64 - w.length_mm as f64) / 1000.0);
             }
         }
